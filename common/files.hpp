@@ -1,0 +1,29 @@
+#pragma once
+// File helpers: write-to-temporary-then-rename (DESIGN.md §7) and content hashes.
+#include <filesystem>
+#include <string>
+
+namespace stentsim::files {
+
+/// Writes `content` to `target` atomically: a temporary file in the same
+/// folder, flushed, then renamed over the target. The old file survives any failure.
+void write_atomic(const std::filesystem::path& target, const std::string& content);
+
+/// A temporary name beside `target` (same folder, so rename is atomic):
+/// "<dir>/.<name>.tmp-<pid>".
+std::filesystem::path temporary_name_for(const std::filesystem::path& target);
+
+/// Renames `from` onto `to`, replacing it (files or folders).
+void replace(const std::filesystem::path& from, const std::filesystem::path& to);
+
+/// Reads a whole file; throws InputError naming it when it cannot be read.
+std::string read_text(const std::filesystem::path& file);
+
+/// 128-bit xxHash (XXH3) of a file's content as 32 hex digits. For a folder,
+/// the hash of its files' relative names and contents in sorted order.
+std::string content_hash(const std::filesystem::path& path);
+
+/// 128-bit xxHash (XXH3) of a string, 32 hex digits.
+std::string text_hash(const std::string& text);
+
+}  // namespace stentsim::files

@@ -1,0 +1,84 @@
+#include "pipeline/stage_process.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+
+#include "common/error.hpp"
+#include "common/log.hpp"
+#include "common/summary.hpp"
+
+namespace stentsim::pipeline {
+namespace {
+
+[[noreturn]] void child_exit(int fd, int code, const std::string& message) {
+  if (!message.empty()) {
+    std::string m = message.substr(0, 16000);
+    [[maybe_unused]] auto w = ::write(fd, m.data(), m.size());
+  }
+  ::close(fd);
+  std::fflush(nullptr);
+  ::_exit(code);  // no atexit handlers, no static destructors of the parent's objects
+}
+
+}  // namespace
+
+StageChild start_stage(const Stage& stage, const std::filesystem::path& work_dir, const std::filesystem::path& temp_dir,
+                       const std::filesystem::path& log_file) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw ComputeError(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
+  std::fflush(nullptr);
+  pid_t pid = ::fork();
+  if (pid < 0) throw ComputeError(fmt::format("cannot start stage '{}': fork failed: {}", stage.name, std::strerror(errno)));
+  if (pid == 0) {
+    ::close(fds[0]);
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      log::set_file(log_file);
+      log::set_prefix(stage.name);
+      StageContext ctx(stage, work_dir, temp_dir);
+      stage.run(ctx);
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      ctx.summary().set_run(wall, peak_memory_mb_self());
+      ctx.summary().write(ctx.output(summary_output(stage.name)));
+      child_exit(fds[1], 0, "");
+    } catch (const std::exception& e) {
+      log::error("{}", e.what());
+      child_exit(fds[1], 1, e.what());
+    } catch (...) {
+      child_exit(fds[1], 1, "unknown error");
+    }
+  }
+  ::close(fds[1]);
+  return {pid, fds[0]};
+}
+
+StageOutcome collect_stage(const StageChild& child, int wait_status, double peak_memory_mb, double duration_s) {
+  StageOutcome o;
+  o.duration_s = duration_s;
+  o.peak_memory_mb = peak_memory_mb;
+  char buf[4096];
+  ssize_t n;
+  while ((n = ::read(child.message_fd, buf, sizeof buf)) > 0) o.message.append(buf, static_cast<std::size_t>(n));
+  ::close(child.message_fd);
+  if (WIFEXITED(wait_status)) {
+    o.ok = WEXITSTATUS(wait_status) == 0;
+    if (!o.ok && o.message.empty()) o.message = fmt::format("exited with status {}", WEXITSTATUS(wait_status));
+  } else if (WIFSIGNALED(wait_status)) {
+    const int sig = WTERMSIG(wait_status);
+    o.interrupted = sig == SIGINT || sig == SIGTERM;
+    o.message = fmt::format("killed by signal {} ({})", sig, ::strsignal(sig));
+  }
+  return o;
+}
+
+}  // namespace stentsim::pipeline

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package stentsim needs to build, run and test.
+# Idempotent and non-interactive; run as root (or with sudo available).
+set -euo pipefail
+
+PKGS=(
+  # toolchain
+  build-essential cmake ninja-build ccache pkg-config git
+  # MPI
+  openmpi-bin libopenmpi-dev
+  # Trilinos 13.2 and the third-party libraries its CMake config names
+  trilinos-all-dev libptscotch-dev libscotch-dev libmumps-dev libhdf5-openmpi-dev
+  liblapack-dev libblas-dev zlib1g-dev libsuitesparse-dev
+  # geometry, meshing, visualization I/O
+  libgmsh-dev libvtk9-dev libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev
+  # configuration, CLI, logging, hashing, XML, threading
+  libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libxxhash-dev libpugixml-dev libtbb-dev
+  # plots (headless PNG/SVG)
+  libplplot-dev plplot-driver-cairo
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+
+missing=()
+for p in "${PKGS[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PKGS[@]} packages already installed"
+  exit 0
+fi
+
+echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

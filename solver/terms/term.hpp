@@ -1,0 +1,72 @@
+#pragma once
+// The one interface every physical term implements (DESIGN.md §2): solids,
+// surface loads, springs, beams, joints and contact pairs add their residual
+// and tangent over their own DOFs, and manage their own history. They meet
+// only in the assembly.
+//
+// Conventions
+// - Residual R = f_int - f_ext; Newton solves K du = -R with K = dR/du.
+// - The global vector `u` holds every DOF. Additive DOFs (displacements,
+//   Hermite tangents) are read from it directly. Rotational DOFs are updated
+//   multiplicatively by the term that owns them: their entries in `du` are
+//   rotation-vector increments (spatial/left convention, Lambda <- exp(S(dtheta)) Lambda,
+//   stated again in the owning term) and `u` carries no meaning there.
+// - MPI: every rank holds the whole `u`; each rank assembles the elements of
+//   its partition (state.rank, state.ranks) and the assembler sums them.
+#include <Eigen/Core>
+
+#include <span>
+#include <string>
+
+namespace stentsim::solver {
+
+using GlobalDof = long long;
+
+/// Where a term reads the current configuration and load level.
+struct SystemState {
+  const Eigen::VectorXd& u;   // all DOFs (additive ones meaningful)
+  double time = 0.0;          // pseudo-time at the end of the current step
+  double dt = 0.0;            // size of the current step
+  int rank = 0, ranks = 1;    // this process's element partition
+  /// Does element `e` (of `n`) belong to this rank? Contiguous blocks.
+  bool owns(std::size_t e, std::size_t n) const {
+    const std::size_t begin = n * static_cast<std::size_t>(rank) / static_cast<std::size_t>(ranks);
+    const std::size_t end = n * static_cast<std::size_t>(rank + 1) / static_cast<std::size_t>(ranks);
+    return e >= begin && e < end;
+  }
+};
+
+/// Receives element contributions; the global assembly sums them.
+class Assembler {
+ public:
+  virtual ~Assembler() = default;
+  /// Adds `residual` (size n) and `tangent` (n x n, row = equation, column =
+  /// DOF) at the global DOFs `dofs`. A negative DOF index is a fixed DOF and
+  /// its row and column are dropped.
+  virtual void add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& residual,
+                   const Eigen::Ref<const Eigen::MatrixXd>& tangent) = 0;
+  /// Adds a residual only (for terms evaluated without tangent, e.g. reactions).
+  virtual bool wants_tangent() const { return true; }
+};
+
+class Term {
+ public:
+  virtual ~Term() = default;
+  virtual std::string name() const = 0;
+
+  /// Adds R and dR/du at `state` (and the term's trial internal state).
+  virtual void assemble(const SystemState& state, Assembler& out) = 0;
+
+  /// Multiplicative DOFs: set the trial state to (accepted iterate) composed
+  /// with the increment `du` (global vector). May be called several times per
+  /// iteration (line search); each call starts from the accepted iterate.
+  virtual void trial(const Eigen::VectorXd& du) {}
+  /// The last trial becomes the accepted iterate.
+  virtual void accept() {}
+  /// The load step converged: history and reference states move forward.
+  virtual void commit() {}
+  /// The load step is cut: go back to the last committed state.
+  virtual void rollback() {}
+};
+
+}  // namespace stentsim::solver

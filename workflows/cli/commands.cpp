@@ -1,0 +1,23 @@
+#include "workflows/cli/commands.hpp"
+
+#include <map>
+
+namespace stentsim::cli {
+namespace {
+std::map<CLI::App*, Handler>& handlers() {
+  static std::map<CLI::App*, Handler> h;
+  return h;
+}
+}  // namespace
+
+void on(CLI::App* sub, Handler handler) { handlers()[sub] = std::move(handler); }
+
+int dispatch(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands()) {
+    auto it = handlers().find(sub);
+    if (it != handlers().end()) return it->second();
+  }
+  return 2;
+}
+
+}  // namespace stentsim::cli

@@ -1,0 +1,31 @@
+// stentsim: the command-line entry point. Each sub-command lives in its own
+// file (cli/cmd_*.cpp) and registers itself here.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include "common/error.hpp"
+#include "workflows/cli/commands.hpp"
+#include "workflows/version.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"stentsim: patient-specific simulation of balloon angioplasty with stent implantation"};
+  app.set_version_flag("--version", std::string(stentsim::kVersion));
+  app.require_subcommand(1);
+  stentsim::cli::register_all(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    return stentsim::cli::dispatch(app);
+  } catch (const stentsim::InputError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}
