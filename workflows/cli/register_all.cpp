@@ -3,7 +3,13 @@
 namespace stentsim::cli {
 
 void register_version(CLI::App& app);
+void register_run(CLI::App& app);
+void register_init(CLI::App& app);
 
-void register_all(CLI::App& app) { register_version(app); }
+void register_all(CLI::App& app) {
+  register_init(app);
+  register_run(app);
+  register_version(app);
+}
 
 }  // namespace stentsim::cli

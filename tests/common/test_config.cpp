@@ -1,0 +1,69 @@
+#include <gtest/gtest.h>
+
+#include "common/config.hpp"
+#include "common/error.hpp"
+
+using namespace stentsim;
+
+namespace {
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Config, ReadsTypedValuesWithUnitsAndDefaults) {
+  auto top = ConfigMap::from_string("device:\n  length: 9.4 mm\n  rings: 4\n  curved: true\n", "case.yaml");
+  auto dev = top.map("device");
+  EXPECT_DOUBLE_EQ(dev.quantity("length", units::kLength), 9.4);
+  EXPECT_EQ(dev.integer("rings"), 4);
+  EXPECT_TRUE(dev.boolean("curved"));
+  EXPECT_DOUBLE_EQ(dev.quantity("wall", units::kLength, 0.04), 0.04);
+  EXPECT_NO_THROW(dev.finish());
+  EXPECT_NO_THROW(top.finish());
+}
+
+TEST(Config, UnknownKeyNamesFileLineKeyAndSuggestion) {
+  auto top = ConfigMap::from_string("device:\n  length: 9.4 mm\n  lenght: 3 mm\n", "case.yaml");
+  auto dev = top.map("device");
+  dev.quantity("length", units::kLength);
+  const auto msg = error_of([&] { dev.finish(); });
+  EXPECT_NE(msg.find("case.yaml:3:3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("device.lenght"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("did you mean 'length'"), std::string::npos) << msg;
+}
+
+TEST(Config, WrongTypeMissingAndOutOfRangeAreErrors) {
+  auto top = ConfigMap::from_string("rings: four\nlength: -1 mm\nlist: {a: 1}\nkind: hex\n", "c.yaml");
+  auto msg = error_of([&] { top.integer("rings"); });
+  EXPECT_NE(msg.find("c.yaml:1:8: rings: expected an integer, got 'four'"), std::string::npos) << msg;
+  msg = error_of([&] { top.quantity("length", units::kLength, std::nullopt, Range::positive()); });
+  EXPECT_NE(msg.find("out of range"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("> 0"), std::string::npos) << msg;
+  msg = error_of([&] { top.number("missing"); });
+  EXPECT_NE(msg.find("missing: required number is missing"), std::string::npos) << msg;
+  msg = error_of([&] { top.number("list"); });
+  EXPECT_NE(msg.find("expected a single value"), std::string::npos) << msg;
+  msg = error_of([&] { top.choice("kind", {"tet4", "tet10"}); });
+  EXPECT_NE(msg.find("'hex' is not one of: tet4, tet10"), std::string::npos) << msg;
+}
+
+TEST(Config, SyntaxErrorNamesTheFile) {
+  auto msg = error_of([] { ConfigMap::from_string("a: [1, 2\n", "broken.yaml"); });
+  EXPECT_NE(msg.find("broken.yaml:"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("YAML syntax error"), std::string::npos) << msg;
+  msg = error_of([] { ConfigMap::load("/nonexistent/case.yaml"); });
+  EXPECT_NE(msg.find("/nonexistent/case.yaml: file not found"), std::string::npos) << msg;
+}
+
+TEST(Config, CanonicalTextIgnoresKeyOrder) {
+  auto a = YAML::Load("{x: 1, y: {b: 2, a: 3}}");
+  auto b = YAML::Load("{y: {a: 3, b: 2}, x: 1}");
+  auto c = YAML::Load("{y: {a: 3, b: 4}, x: 1}");
+  EXPECT_EQ(canonical_yaml(a), canonical_yaml(b));
+  EXPECT_NE(canonical_yaml(a), canonical_yaml(c));
+}

@@ -1,0 +1,50 @@
+#pragma once
+// Test-only stages for the runner tests (never part of the product): each
+// concatenates its inputs plus its config into its output and appends a line
+// to a counter file so tests can see how often it ran (stages run in child
+// processes, so in-memory counters would not work).
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "pipeline/stage.hpp"
+
+namespace stentsim::testing {
+
+inline int run_count(const std::filesystem::path& counters, const std::string& stage) {
+  std::ifstream in(counters / stage);
+  int n = 0;
+  std::string line;
+  while (std::getline(in, line)) ++n;
+  return n;
+}
+
+/// A stage `name` reading `inputs`, writing `output`. Its config may contain
+/// the words "fail", "crash" or "sleep" to fail, abort or sleep 30 s.
+inline pipeline::Stage concat_stage(const std::string& name, std::vector<std::string> inputs, const std::string& output,
+                                    const std::string& config, const std::filesystem::path& counters) {
+  pipeline::Stage s;
+  s.name = name;
+  s.inputs = std::move(inputs);
+  s.outputs = {output};
+  s.config = config;
+  s.run = [name, output, config, counters](pipeline::StageContext& ctx) {
+    std::filesystem::create_directories(counters);
+    std::ofstream(counters / name, std::ios::app) << "ran\n";
+    if (config.find("sleep") != std::string::npos) std::this_thread::sleep_for(std::chrono::seconds(30));
+    if (config.find("crash") != std::string::npos) std::abort();
+    if (config.find("fail") != std::string::npos) throw InputError("deliberate failure of " + name);
+    std::string text;
+    for (const auto& in : ctx.stage().inputs) text += files::read_text(ctx.input(in));
+    text += name + ":" + config + "\n";
+    files::write_atomic(ctx.output(output), text);
+    ctx.summary().set("length", static_cast<double>(text.size()), "byte");
+  };
+  return s;
+}
+
+}  // namespace stentsim::testing

@@ -1,0 +1,74 @@
+// Case files: validation of every section, init examples load and validate.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "workflows/case_config.hpp"
+#include "workflows/case_stages.hpp"
+#include "workflows/init_case.hpp"
+
+namespace fs = std::filesystem;
+using namespace stentsim;
+using namespace stentsim::workflows;
+
+namespace {
+fs::path temp_dir() {
+  auto d = fs::temp_directory_path() / ("stentsim-case-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+std::string load_error(const std::string& text) {
+  const auto f = temp_dir() / "bad.yaml";
+  files::write_atomic(f, text);
+  try {
+    load_case(f);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(CaseConfig, EveryExampleLoadsAndValidates) {
+  const auto dir = temp_dir() / "init";
+  fs::remove_all(dir);
+  for (const char* scene : {"free-expansion", "generic-artery", "patient"}) {
+    const auto f = write_example_case(dir, scene);
+    const auto c = load_case(f);
+    EXPECT_EQ(to_string(c.scene), std::string(scene));
+    EXPECT_EQ(c.work_dir, (dir / (std::string(scene) + ".work")).lexically_normal());
+    EXPECT_THROW(write_example_case(dir, scene), InputError);  // never overwrites
+  }
+  const auto c = load_case(dir / "patient.yaml");
+  EXPECT_NEAR(c.simulation.diastolic_pressure, 85 * 133.322387415e-6, 1e-15);
+  EXPECT_DOUBLE_EQ(c.simulation.pressure_max, 1.01);
+  EXPECT_DOUBLE_EQ(c.mesh.size, 0.25);
+  fs::remove_all(dir);
+}
+
+TEST(CaseConfig, BadFilesGiveErrorsThatNameFileLineKeyAndExpectation) {
+  auto msg = load_error("scene: patient\nmesh:\n  size: 0.25 mm\n  elemnt: tet4\n");
+  EXPECT_NE(msg.find("bad.yaml:4:3: mesh.elemnt: unknown key"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("did you mean 'element'"), std::string::npos) << msg;
+  msg = load_error("mesh: {size: 1 mm}\n");
+  EXPECT_NE(msg.find("scene: required text is missing"), std::string::npos) << msg;
+  msg = load_error("scene: hospital\n");
+  EXPECT_NE(msg.find("'hospital' is not one of"), std::string::npos) << msg;
+  msg = load_error("scene: patient\nsimulation:\n  pressure_max: 13 mm\n");
+  EXPECT_NE(msg.find("simulation.pressure_max"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("expected a pressure"), std::string::npos) << msg;
+  msg = load_error("scene: patient\nsimulation:\n  load_steps: 0\n");
+  EXPECT_NE(msg.find("out of range"), std::string::npos) << msg;
+  msg = load_error("scene: patient\nsimulation:\n  load_steps: many\n");
+  EXPECT_NE(msg.find("expected an integer, got 'many'"), std::string::npos) << msg;
+  msg = load_error("scene: free-expansion\ninput:\n  phantom: {preset: case2-rca}\n");
+  EXPECT_NE(msg.find("has no artery input"), std::string::npos) << msg;
+  msg = load_error("scene: generic-artery\nmesh:\n  generic: {outer_diameter: 1 mm}\n");
+  EXPECT_NE(msg.find("less than outer_diameter"), std::string::npos) << msg;
+}
+
+TEST(CaseConfig, StageNamesFollowTheDesign) {
+  EXPECT_EQ(all_stage_names(), (std::vector<std::string>{"segmentation", "centerline", "placement", "balloon", "stent",
+                                                         "mesh", "fibers", "solve", "report"}));
+}

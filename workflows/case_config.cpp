@@ -1,0 +1,115 @@
+#include "workflows/case_config.hpp"
+
+#include <fmt/format.h>
+
+#include <numbers>
+#include <sstream>
+
+#include "common/config.hpp"
+#include "common/error.hpp"
+#include "workflows/case_sections.hpp"
+
+namespace stentsim::workflows {
+
+const char* to_string(Scene s) {
+  switch (s) {
+    case Scene::free_expansion: return "free-expansion";
+    case Scene::generic_artery: return "generic-artery";
+    case Scene::patient: return "patient";
+  }
+  return "";
+}
+
+YAML::Node CaseConfig::section(const std::string& dotted) const {
+  YAML::Node n = YAML::Clone(root);
+  std::stringstream ss(dotted);
+  std::string part;
+  while (std::getline(ss, part, '.')) {
+    if (!n.IsMap() || !n[part]) return YAML::Node(YAML::NodeType::Map);
+    n = n[part];
+  }
+  return n;
+}
+
+namespace {
+
+MeshSettings parse_mesh(ConfigMap m, GenericArterySettings& generic) {
+  MeshSettings s;
+  s.element = m.choice("element", {"tet10", "tet4"}, s.element);
+  s.size = m.quantity("size", units::kLength, s.size, Range::positive());
+  s.min_elements_per_layer = m.integer("min_elements_per_layer", s.min_elements_per_layer, Range::between(1, 20));
+  s.media_ratio = m.number("media_ratio", s.media_ratio, Range::between(0, 0.5));
+  s.adventitia_ratio = m.number("adventitia_ratio", s.adventitia_ratio, Range::between(0, 0.5));
+  s.min_intima = m.quantity("min_intima", units::kLength, s.min_intima, Range::non_negative());
+  s.min_scaled_jacobian = m.number("min_scaled_jacobian", s.min_scaled_jacobian, Range::between(0, 1));
+  if (auto g = m.optional_map("generic")) {
+    generic.length = g->quantity("length", units::kLength, generic.length, Range::positive());
+    generic.outer_diameter = g->quantity("outer_diameter", units::kLength, generic.outer_diameter, Range::positive());
+    generic.media_thickness = g->quantity("media_thickness", units::kLength, generic.media_thickness, Range::positive());
+    generic.adventitia_thickness =
+        g->quantity("adventitia_thickness", units::kLength, generic.adventitia_thickness, Range::positive());
+    if (2 * (generic.media_thickness + generic.adventitia_thickness) >= generic.outer_diameter)
+      g->fail("", "media_thickness + adventitia_thickness must be less than outer_diameter / 2");
+    g->finish();
+  }
+  m.finish();
+  return s;
+}
+
+FiberSettings parse_fibers(ConfigMap m) {
+  FiberSettings s;
+  const Range angle = Range::between(-std::numbers::pi / 2, std::numbers::pi / 2);
+  s.media_angle = m.quantity("media_angle", units::kAngle, s.media_angle, angle);
+  s.intima_angle = m.quantity("intima_angle", units::kAngle, s.intima_angle, angle);
+  s.adventitia_angle = m.quantity("adventitia_angle", units::kAngle, s.adventitia_angle, angle);
+  s.tension_only = m.boolean("tension_only", s.tension_only);
+  m.finish();
+  return s;
+}
+
+SimulationSettings parse_simulation(ConfigMap m) {
+  SimulationSettings s;
+  s.pressure_max = m.quantity("pressure_max", units::kPressure, s.pressure_max, Range::between(0, 10));
+  s.diastolic_pressure = m.quantity("diastolic_pressure", units::kPressure, s.diastolic_pressure, Range::between(0, 0.1));
+  s.phase_duration = m.quantity("phase_duration", units::kTime, s.phase_duration, Range::positive());
+  s.load_steps = m.integer("load_steps", s.load_steps, Range::between(1, 100000));
+  s.linear_solver = m.choice("linear_solver", {"direct", "gmres-ilu", "gmres-amg"}, s.linear_solver);
+  s.ranks = m.integer("ranks", s.ranks, Range::between(1, 4096));
+  s.balloon_end_springs = m.quantity("balloon_end_springs", units::kStiffnessPerArea, s.balloon_end_springs, Range::positive());
+  s.cut_springs = m.quantity("cut_springs", units::kStiffnessPerArea, s.cut_springs, Range::positive());
+  s.beam_penalty = m.quantity("beam_penalty", units::kPressure, s.beam_penalty, Range::positive());
+  s.surface_penalty = m.quantity("surface_penalty", units::kStiffnessPerArea, s.surface_penalty, Range::positive());
+  m.finish();
+  return s;
+}
+
+OutputSettings parse_output(ConfigMap m) {
+  OutputSettings s;
+  s.every = m.integer("every", s.every, Range::between(1, 1000000));
+  m.finish();
+  return s;
+}
+
+}  // namespace
+
+CaseConfig load_case(const std::filesystem::path& file) {
+  ConfigMap top = ConfigMap::load(file);
+  CaseConfig c;
+  c.file = std::filesystem::absolute(file).lexically_normal();
+  c.root = top.node();
+  c.name = top.string("name", file.stem().string());
+  const std::string scene = top.choice("scene", {"free-expansion", "generic-artery", "patient"});
+  c.scene = scene == "free-expansion" ? Scene::free_expansion : scene == "generic-artery" ? Scene::generic_artery : Scene::patient;
+  c.work_dir = top.path("work_dir", std::filesystem::path(file.stem().string() + ".work"));
+  c.mesh = parse_mesh(top.map("mesh"), c.generic_artery);
+  c.fibers = parse_fibers(top.map("fibers"));
+  c.simulation = parse_simulation(top.map("simulation"));
+  c.output = parse_output(top.map("output"));
+  // Input and device sections are validated by the parsers of the stages
+  // that read them (case_sections.cpp), so a bad key fails before any run.
+  validate_stage_sections(c, top);
+  top.finish();
+  return c;
+}
+
+}  // namespace stentsim::workflows

@@ -1,0 +1,74 @@
+#pragma once
+// A case: one YAML file (patient or scene) with sections input, device, mesh,
+// fibers, simulation, output. The whole file is validated before anything
+// runs; every section keeps its raw YAML so that each stage hashes exactly the
+// slice it depends on.
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <string>
+
+namespace stentsim::workflows {
+
+enum class Scene { free_expansion, generic_artery, patient };
+const char* to_string(Scene s);
+
+/// Settings of the sections owned by the solve stage and its preprocessing
+/// (mesh, fibers, simulation, output), validated with units. Device and input
+/// sections are validated by their stages' own parsers.
+struct MeshSettings {
+  std::string element = "tet10";  // tet10 | tet4
+  double size = 0.25;             // mm, target edge length
+  int min_elements_per_layer = 2;
+  double media_ratio = 0.0786, adventitia_ratio = 0.136;  // of the local outer diameter (DESIGN §5)
+  double min_intima = 0.05;                               // mm
+  double min_scaled_jacobian = 0.1;
+};
+
+struct GenericArterySettings {  // paper Case 1 (DESIGN §5)
+  double length = 11.0, outer_diameter = 2.8, media_thickness = 0.22, adventitia_thickness = 0.38;
+};
+
+struct FiberSettings {
+  double media_angle = 0.0, intima_angle = 0.0, adventitia_angle = 0.6981317007977318;  // rad (40 deg)
+  bool tension_only = false;
+};
+
+struct SimulationSettings {
+  double pressure_max = 1.01;              // MPa
+  double diastolic_pressure = 85 * 133.322387415e-6;  // MPa
+  double phase_duration = 1.0;             // s of pseudo-time per phase
+  int load_steps = 100;                    // per phase, initial
+  std::string linear_solver = "gmres-ilu"; // direct | gmres-ilu | gmres-amg
+  int ranks = 1;
+  double balloon_end_springs = 100.0;      // N/mm^3
+  double cut_springs = 1000.0;             // N/mm^3
+  double beam_penalty = 10.0;              // N/mm^2
+  double surface_penalty = 5.0;            // N/mm^3
+};
+
+struct OutputSettings {
+  int every = 1;  // write results every N converged steps
+};
+
+struct CaseConfig {
+  std::filesystem::path file;
+  std::string name;
+  Scene scene = Scene::patient;
+  std::filesystem::path work_dir;
+  YAML::Node root;  // the whole file, for stage configuration slices
+  MeshSettings mesh;
+  GenericArterySettings generic_artery;
+  FiberSettings fibers;
+  SimulationSettings simulation;
+  OutputSettings output;
+
+  /// The raw YAML of a section ("device.stent"); an empty map when absent.
+  YAML::Node section(const std::string& dotted) const;
+};
+
+/// Reads and validates a case file. Throws InputError naming file:line, key
+/// and expectation for unknown keys, wrong types, missing or out-of-range values.
+CaseConfig load_case(const std::filesystem::path& file);
+
+}  // namespace stentsim::workflows

@@ -1,0 +1,25 @@
+// `stentsim init DIR --scene SCENE`: a commented, runnable example case.
+#include <cstdio>
+
+#include "workflows/cli/commands.hpp"
+#include "workflows/init_case.hpp"
+
+namespace stentsim::cli {
+
+void register_init(CLI::App& app) {
+  struct Args {
+    std::string dir, scene = "patient";
+  };
+  auto a = std::make_shared<Args>();
+  auto* sub = app.add_subcommand("init", "Write a commented, runnable example case into DIR");
+  sub->add_option("dir", a->dir, "Folder for the case")->required();
+  sub->add_option("--scene", a->scene, "Scene of the example")
+      ->check(CLI::IsMember({"free-expansion", "generic-artery", "patient"}));
+  on(sub, [a] {
+    const auto file = workflows::write_example_case(a->dir, a->scene);
+    std::printf("wrote %s\nrun it with: stentsim run %s\n", file.c_str(), file.c_str());
+    return 0;
+  });
+}
+
+}  // namespace stentsim::cli
