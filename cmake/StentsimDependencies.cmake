@@ -38,7 +38,7 @@ target_link_libraries(stentsim_xxhash INTERFACE ${XXHASH_LIBRARY})
 # VTK: name the components, otherwise Debian's config also wants Qt5 dev packages.
 find_package(VTK 9.1 QUIET COMPONENTS
   CommonCore CommonDataModel IOXML IOLegacy IOGeometry FiltersCore FiltersGeneral
-  FiltersGeometry FiltersModeling FiltersExtraction ImagingCore IOImage)
+  FiltersGeometry FiltersModeling FiltersExtraction FiltersSources ImagingCore IOImage)
 stentsim_require(VTK_FOUND libvtk9-dev "VTK 9.1 (${VTK_NOT_FOUND_MESSAGE})")
 
 find_package(CGAL QUIET)
