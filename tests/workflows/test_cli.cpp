@@ -1,0 +1,83 @@
+// The stentsim binary end to end: init, run, status, a second run that
+// skips everything, and exit codes for bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "common/files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string out;
+};
+
+Result sh(const std::string& args) {
+  const char* bin = STENTSIM_TEST_BINARY;
+  std::string cmd = std::string(bin) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  int status = ::pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() / ("stentsim-cli-" + std::to_string(::getpid()) + "-" +
+                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  fs::path dir;
+};
+
+TEST_F(Cli, BadInputExitsWithTwoAndNamesTheProblem) {
+  auto r = sh("run " + (dir / "missing.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("missing.yaml: file not found"), std::string::npos) << r.out;
+  stentsim::files::write_atomic(dir / "bad.yaml", "scene: patient\nsimulation:\n  presure_max: 1 MPa\n");
+  r = sh("run " + (dir / "bad.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("bad.yaml:3:3: simulation.presure_max: unknown key"), std::string::npos) << r.out;
+  r = sh("run " + (dir / "bad.yaml").string() + " --jobs 0");
+  EXPECT_EQ(r.code, 2);
+  r = sh("frobnicate");
+  EXPECT_EQ(r.code, 2);
+}
+
+TEST_F(Cli, InitRunStatusAndSecondRunSkipsEveryStage) {
+  for (const char* scene : {"free-expansion", "generic-artery", "patient"}) {
+    auto r = sh("init " + dir.string() + " --scene " + scene);
+    ASSERT_EQ(r.code, 0) << r.out;
+    const std::string c = (dir / (std::string(scene) + ".yaml")).string();
+    r = sh("run " + c + " --dry-run");
+    EXPECT_EQ(r.code, 0) << r.out;
+    r = sh("run " + c);
+    ASSERT_EQ(r.code, 0) << r.out;
+    r = sh("run " + c);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_TRUE(r.out.find(" 0 ran, ") != std::string::npos || r.out.find("no stages") != std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("run   "), std::string::npos) << r.out;
+    r = sh("status " + c);
+    EXPECT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(r.out.find("stale"), std::string::npos) << r.out;
+    // init never overwrites.
+    r = sh("init " + dir.string() + " --scene " + scene);
+    EXPECT_EQ(r.code, 2) << r.out;
+  }
+}
+
+}  // namespace
