@@ -1,0 +1,25 @@
+#pragma once
+// One exponential fiber family (Holzapfel-Gasser-Ogden; paper App. B):
+//   Psi = k1 / (2 k2) (exp(k2 (I4 - 1)^2) - 1),  I4 = M . C M.
+// S  = 2 Psi' M (x) M,            Psi'  = k1 (I4 - 1) exp(k2 (I4 - 1)^2)
+// CC = 4 Psi'' M (x) M (x) M (x) M, Psi'' = k1 exp(k2 (I4 - 1)^2) (1 + 2 k2 (I4 - 1)^2)
+// `tension_only`: no contribution while I4 < 1 (fibers do not carry
+// compression; DESIGN.md §8 keeps the paper's both-ways form as default).
+// `multiplicity` counts coinciding families (two families at 0 deg count twice).
+#include "solver/fem/tensor.hpp"
+#include "solver/materials/point_status.hpp"
+
+namespace stentsim::solver {
+
+struct FiberFamily {
+  double k1 = 0.0;  // MPa
+  double k2 = 0.0;  // dimensionless
+  bool tension_only = false;
+  double multiplicity = 1.0;
+
+  double energy(const Mat3& cauchy_green, const Vec3& m) const;
+  /// Adds S and dS/dE (when `tangent` is not null) for the unit reference direction `m`.
+  PointStatus add(const Mat3& cauchy_green, const Vec3& m, Vec6& stress, Mat6* tangent) const;
+};
+
+}  // namespace stentsim::solver

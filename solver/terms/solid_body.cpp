@@ -1,0 +1,159 @@
+#include "solver/terms/solid_body.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "common/error.hpp"
+#include "solver/terms/element_failure.hpp"
+#include "solver/terms/solid_kernel.hpp"
+
+namespace stentsim::solver {
+namespace {
+
+bool is_volume(CellType t) {
+  return t == CellType::hexahedron || t == CellType::tetra || t == CellType::quadratic_tetra;
+}
+
+int points_of(CellType t) {
+  switch (t) {
+    case CellType::hexahedron: return fem::Hex8::kRule.kPoints;
+    case CellType::tetra: return fem::Tet4::kRule.kPoints;
+    case CellType::quadratic_tetra: return fem::Tet10::kRule.kPoints;
+    default: return 0;
+  }
+}
+
+}  // namespace
+
+SolidBody::SolidBody(SolidBodySpec spec, GlobalDof first_dof)
+    : name_(std::move(spec.name)),
+      mesh_(std::move(spec.mesh)),
+      materials_(std::move(spec.materials)),
+      cell_material_(std::move(spec.cell_material)),
+      first_dof_(first_dof) {
+  if (cell_material_.size() != mesh_.num_cells())
+    throw InputError(fmt::format("body '{}': {} material indices for {} cells", name_, cell_material_.size(), mesh_.num_cells()));
+  std::array<Vec3, kMaxFiberFamilies> none;
+  none.fill(Vec3::Zero());
+  fiber_dirs_.assign(mesh_.num_cells(), none);
+  long long slots = 0;
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
+    const int m = cell_material_[c];
+    if (m < 0) continue;
+    if (m >= static_cast<int>(materials_.size()))
+      throw InputError(fmt::format("body '{}': cell {} refers to material {} of {}", name_, c, m, materials_.size()));
+    if (!is_volume(mesh_.cell_types[c]))
+      throw InputError(fmt::format("body '{}': cell {} has VTK type {}, expected a volume cell (hex8, tet4, tet10)",
+                                   name_, c, static_cast<int>(mesh_.cell_types[c])));
+    const Material& mat = materials_[static_cast<std::size_t>(m)];
+    if (mat.fibers.size() > static_cast<std::size_t>(kMaxFiberFamilies))
+      throw InputError(fmt::format("material '{}' has {} fiber families; at most {}", mat.name, mat.fibers.size(), kMaxFiberFamilies));
+    for (std::size_t f = 0; f < mat.fibers.size(); ++f) {
+      const auto& fam = mat.fibers[f];
+      Vec3 a;
+      if (fam.global_direction) {
+        a = *fam.global_direction;
+      } else {
+        if (spec.cell_frames.size() != mesh_.num_cells())
+          throw InputError(fmt::format("body '{}': material '{}' gives fiber angles but the body has no local "
+                                       "(radial, circumferential, longitudinal) frames", name_, mat.name));
+        const double phi = fam.angle_deg * std::numbers::pi / 180.0;
+        a = std::cos(phi) * spec.cell_frames[c][1] + std::sin(phi) * spec.cell_frames[c][2];
+      }
+      if (!(a.norm() > 1e-12)) throw InputError(fmt::format("body '{}': cell {} has a zero fiber direction", name_, c));
+      fiber_dirs_[c][f] = a.normalized();
+    }
+    Element el{c, m, -1};
+    if (mat.viscous) {
+      el.history = slots;
+      slots += points_of(mesh_.cell_types[c]);
+    }
+    elements_.push_back(el);
+  }
+  committed_.assign(static_cast<std::size_t>(slots), ViscousHistory{});
+  trial_ = committed_;
+}
+
+Vec3 SolidBody::position(const Eigen::VectorXd& u, std::size_t node) const {
+  return mesh_.points[node] + u.segment<3>(dof(node, 0));
+}
+
+void SolidBody::fail(const Element& el, const char* type, int point, const char* why) const {
+  throw ElementFailure(fmt::format("body '{}', element {} ({}, material '{}'), quadrature point {}: {}", name_, el.cell, type,
+                                   materials_[static_cast<std::size_t>(el.material)].name, point, why));
+}
+
+template <class E>
+void SolidBody::assemble_element(const Element& el, const SystemState& state, Assembler& out, bool tangent) {
+  using K = SolidElement<E>;
+  typename K::NodeMat xr, xc;
+  std::array<GlobalDof, K::kDofs> dofs;
+  const std::int64_t* conn = &mesh_.connectivity[static_cast<std::size_t>(mesh_.cell_offsets[el.cell])];
+  for (int i = 0; i < E::kNodes; ++i) {
+    const auto node = static_cast<std::size_t>(conn[i]);
+    xr.col(i) = mesh_.points[node];
+    for (int a = 0; a < 3; ++a) dofs[3 * i + a] = dof(node, a);
+    xc.col(i) = xr.col(i) + state.u.segment<3>(dofs[3 * i]);
+  }
+  typename K::Vec r;
+  typename K::Mat k;
+  const ViscousHistory* hist = el.history >= 0 ? &committed_[static_cast<std::size_t>(el.history)] : nullptr;
+  ViscousHistory* trial = el.history >= 0 ? &trial_[static_cast<std::size_t>(el.history)] : nullptr;
+  const auto res = K::evaluate(xr, xc, materials_[static_cast<std::size_t>(el.material)], fiber_dirs_[el.cell].data(),
+                               hist, trial, state.dt, r, tangent ? &k : nullptr);
+  if (!res.status.ok) fail(el, E::kName, res.point, res.status.why);
+  if (!r.allFinite() || (tangent && !k.allFinite())) fail(el, E::kName, -1, "residual or tangent not finite");
+  if (tangent) out.add(dofs, r, k);
+  else out.add(dofs, r, Eigen::MatrixXd());
+}
+
+void SolidBody::assemble(const SystemState& state, Assembler& out) {
+  const bool tangent = out.wants_tangent();
+  const std::size_t n = elements_.size();
+  for (std::size_t e = 0; e < n; ++e) {
+    if (!state.owns(e, n)) continue;
+    const Element& el = elements_[e];
+    switch (mesh_.cell_types[el.cell]) {
+      case CellType::hexahedron: assemble_element<fem::Hex8>(el, state, out, tangent); break;
+      case CellType::tetra: assemble_element<fem::Tet4>(el, state, out, tangent); break;
+      case CellType::quadratic_tetra: assemble_element<fem::Tet10>(el, state, out, tangent); break;
+      default: break;
+    }
+  }
+}
+
+template <class E>
+void SolidBody::cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& cauchy, Mat3& strain) const {
+  using K = SolidElement<E>;
+  typename K::NodeMat xr, xc;
+  const std::int64_t* conn = &mesh_.connectivity[static_cast<std::size_t>(mesh_.cell_offsets[el.cell])];
+  for (int i = 0; i < E::kNodes; ++i) {
+    const auto node = static_cast<std::size_t>(conn[i]);
+    xr.col(i) = mesh_.points[node];
+    xc.col(i) = position(u, node);
+  }
+  const ViscousHistory* hist = el.history >= 0 ? &committed_[static_cast<std::size_t>(el.history)] : nullptr;
+  double volume = 0.0;
+  const auto res = K::averages(xr, xc, materials_[static_cast<std::size_t>(el.material)], fiber_dirs_[el.cell].data(),
+                               hist, cauchy, strain, volume);
+  if (!res.status.ok) fail(el, E::kName, res.point, res.status.why);
+}
+
+SolidCellFields SolidBody::cell_fields(const Eigen::VectorXd& u) const {
+  SolidCellFields out;
+  out.cauchy.assign(mesh_.num_cells(), Mat3::Zero());
+  out.strain.assign(mesh_.num_cells(), Mat3::Zero());
+  for (const Element& el : elements_) {
+    switch (mesh_.cell_types[el.cell]) {
+      case CellType::hexahedron: cell_average<fem::Hex8>(el, u, out.cauchy[el.cell], out.strain[el.cell]); break;
+      case CellType::tetra: cell_average<fem::Tet4>(el, u, out.cauchy[el.cell], out.strain[el.cell]); break;
+      case CellType::quadratic_tetra: cell_average<fem::Tet10>(el, u, out.cauchy[el.cell], out.strain[el.cell]); break;
+      default: break;
+    }
+  }
+  return out;
+}
+
+}  // namespace stentsim::solver
