@@ -33,7 +33,7 @@ YAML::Node CaseConfig::section(const std::string& dotted) const {
 
 namespace {
 
-MeshSettings parse_mesh(ConfigMap m, GenericArterySettings& generic) {
+MeshSettings parse_mesh(ConfigMap m, meshing::GenericArterySpec& generic) {
   MeshSettings s;
   s.element = m.choice("element", {"tet10", "tet4"}, s.element);
   s.size = m.quantity("size", units::kLength, s.size, Range::positive());
@@ -48,6 +48,10 @@ MeshSettings parse_mesh(ConfigMap m, GenericArterySettings& generic) {
     generic.media_thickness = g->quantity("media_thickness", units::kLength, generic.media_thickness, Range::positive());
     generic.adventitia_thickness =
         g->quantity("adventitia_thickness", units::kLength, generic.adventitia_thickness, Range::positive());
+    generic.elements_around = g->integer("elements_around", generic.elements_around, Range::between(8, 4096));
+    generic.elements_along = g->integer("elements_along", generic.elements_along, Range::between(1, 100000));
+    generic.elements_media = g->integer("elements_media", generic.elements_media, Range::between(1, 100));
+    generic.elements_adventitia = g->integer("elements_adventitia", generic.elements_adventitia, Range::between(1, 100));
     if (2 * (generic.media_thickness + generic.adventitia_thickness) >= generic.outer_diameter)
       g->fail("", "media_thickness + adventitia_thickness must be less than outer_diameter / 2");
     g->finish();

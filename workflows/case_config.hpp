@@ -8,6 +8,10 @@
 #include <filesystem>
 #include <string>
 
+#include "meshing/generic_artery.hpp"
+
+
+
 namespace stentsim::workflows {
 
 enum class Scene { free_expansion, generic_artery, patient };
@@ -25,9 +29,6 @@ struct MeshSettings {
   double min_scaled_jacobian = 0.1;
 };
 
-struct GenericArterySettings {  // paper Case 1 (DESIGN §5)
-  double length = 11.0, outer_diameter = 2.8, media_thickness = 0.22, adventitia_thickness = 0.38;
-};
 
 struct FiberSettings {
   double media_angle = 0.0, intima_angle = 0.0, adventitia_angle = 0.6981317007977318;  // rad (40 deg)
@@ -58,7 +59,7 @@ struct CaseConfig {
   std::filesystem::path work_dir;
   YAML::Node root;  // the whole file, for stage configuration slices
   MeshSettings mesh;
-  GenericArterySettings generic_artery;
+  meshing::GenericArterySpec generic_artery;  // paper Case 1 (DESIGN §5)
   FiberSettings fibers;
   SimulationSettings simulation;
   OutputSettings output;

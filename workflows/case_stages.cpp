@@ -1,8 +1,54 @@
 #include "workflows/case_stages.hpp"
 
 #include "common/config.hpp"
+#include "common/mesh_tags.hpp"
+#include "fibers/analytic_tube_fibers.hpp"
+#include "meshing/generic_artery.hpp"
 
 namespace stentsim::workflows {
+namespace {
+
+using pipeline::Stage;
+using pipeline::StageContext;
+
+/// The configuration text a stage depends on: the named sections, canonical.
+std::string slice(const CaseConfig& c, std::initializer_list<const char*> sections) {
+  std::string text = std::string("scene=") + to_string(c.scene) + ";";
+  for (const char* s : sections) text += std::string(s) + "=" + canonical_yaml(c.section(s)) + ";";
+  return text;
+}
+
+Stage generic_mesh_stage(const CaseConfig& c) {
+  Stage s;
+  s.name = "mesh";
+  s.outputs = {"mesh/artery.vtu"};
+  s.config = slice(c, {"mesh.generic"});
+  s.version = "1";
+  const meshing::GenericArterySpec spec = c.generic_artery;
+  s.run = [spec](StageContext& ctx) {
+    meshing::write_generic_artery(spec, ctx.output("mesh/artery.vtu").string(), ctx.summary());
+  };
+  return s;
+}
+
+Stage tube_fibers_stage(const CaseConfig& c) {
+  Stage s;
+  s.name = "fibers";
+  s.inputs = {"mesh/artery.vtu"};
+  s.outputs = {"fibers/fibers.vtu"};
+  s.config = slice(c, {"fibers"});
+  s.version = "1";
+  const fibers::LayerAngles angles = {{tags::intima, c.fibers.intima_angle},
+                                      {tags::media, c.fibers.media_angle},
+                                      {tags::adventitia, c.fibers.adventitia_angle}};
+  s.run = [angles](StageContext& ctx) {
+    fibers::write_tube_fibers(ctx.input("mesh/artery.vtu").string(), angles, ctx.output("fibers/fibers.vtu").string(),
+                              ctx.summary());
+  };
+  return s;
+}
+
+}  // namespace
 
 const std::vector<std::string>& all_stage_names() {
   static const std::vector<std::string> names = {"segmentation", "centerline", "placement", "balloon", "stent",
@@ -12,6 +58,16 @@ const std::vector<std::string>& all_stage_names() {
 
 std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
   std::vector<pipeline::Stage> stages;
+  switch (c.scene) {
+    case Scene::free_expansion:
+      break;
+    case Scene::generic_artery:
+      stages.push_back(generic_mesh_stage(c));
+      stages.push_back(tube_fibers_stage(c));
+      break;
+    case Scene::patient:
+      break;
+  }
   return stages;
 }
 
