@@ -3,6 +3,7 @@
 // element kernel. Voigt order: 11, 22, 33, 12, 23, 13; strains carry
 // engineering shears (2 E12), stresses do not, so that S : dE = S_v . dE_v.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include <array>
