@@ -1,13 +1,23 @@
 #include "workflows/case_sections.hpp"
 
+#include "segmentation_io/phantom.hpp"
+
 namespace stentsim::workflows {
 
 void validate_stage_sections(const CaseConfig& c, ConfigMap& top) {
-  if (c.scene != Scene::patient && top.has("input"))
-    top.fail("input", "a " + std::string(to_string(c.scene)) + " scene has no artery input; remove this section");
-  auto input = top.map("input");
+  if (c.scene != Scene::patient) {
+    if (top.has("input"))
+      top.fail("input", "a " + std::string(to_string(c.scene)) + " scene has no artery input; remove this section");
+  } else {
+    if (!top.has("input")) top.fail("input", "a patient scene needs an input section (e.g. input: {phantom: {preset: case2-rca}})");
+    auto input = top.map("input");
+    if (!input.has("phantom")) input.fail("", "expected 'phantom' (surface files, SimVascular and label images are not supported yet)");
+    auto phantom = input.map("phantom");
+    segmentation::parse_phantom(phantom);
+    input.finish();
+  }
+  // Device sections are validated by the device stages' parsers once they are wired.
   auto device = top.map("device");
-  (void)input;
   (void)device;
 }
 

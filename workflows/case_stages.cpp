@@ -1,9 +1,12 @@
 #include "workflows/case_stages.hpp"
 
+#include <fmt/format.h>
+
 #include "common/config.hpp"
 #include "common/mesh_tags.hpp"
 #include "fibers/analytic_tube_fibers.hpp"
 #include "meshing/generic_artery.hpp"
+#include "segmentation_io/phantom.hpp"
 
 namespace stentsim::workflows {
 namespace {
@@ -13,8 +16,8 @@ using pipeline::StageContext;
 
 /// The configuration text a stage depends on: the named sections, canonical.
 std::string slice(const CaseConfig& c, std::initializer_list<const char*> sections) {
-  std::string text = std::string("scene=") + to_string(c.scene) + ";";
-  for (const char* s : sections) text += std::string(s) + "=" + canonical_yaml(c.section(s)) + ";";
+  std::string text = fmt::format("scene={};", to_string(c.scene));
+  for (const char* s : sections) text += fmt::format("{}={};", s, canonical_yaml(c.section(s)));
   return text;
 }
 
@@ -48,6 +51,22 @@ Stage tube_fibers_stage(const CaseConfig& c) {
   return s;
 }
 
+Stage phantom_segmentation_stage(const CaseConfig& c) {
+  Stage s;
+  s.name = "segmentation";
+  s.outputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp", "segmentation/centerline_true.vtp"};
+  s.config = slice(c, {"input"});
+  s.version = "1";
+  ConfigMap input(c.section("input"), std::make_shared<const std::filesystem::path>(c.file), "input");
+  auto section = input.map("phantom");
+  const segmentation::PhantomSpec spec = segmentation::parse_phantom(section);
+  s.run = [spec](StageContext& ctx) {
+    segmentation::write_phantom(spec, ctx.output("segmentation/lumen.vtp"), ctx.output("segmentation/wall.vtp"),
+                                ctx.output("segmentation/centerline_true.vtp"), ctx.summary());
+  };
+  return s;
+}
+
 }  // namespace
 
 const std::vector<std::string>& all_stage_names() {
@@ -66,6 +85,7 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
       stages.push_back(tube_fibers_stage(c));
       break;
     case Scene::patient:
+      stages.push_back(phantom_segmentation_stage(c));
       break;
   }
   return stages;
