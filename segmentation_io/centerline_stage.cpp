@@ -1,0 +1,66 @@
+// The centerline stage: lumen.vtp -> centerline.vtp + summary QoIs.
+#include <fmt/format.h>
+
+#include "common/error.hpp"
+#include "common/log.hpp"
+#include "segmentation_io/centerline.hpp"
+
+namespace stentsim::segmentation {
+
+CenterlineOptions parse_centerline_options(ConfigMap& section) {
+  CenterlineOptions o;
+  o.spacing = section.quantity("spacing", units::kLength, 0.1, Range::positive());
+  bool has_s = section.has("source"), has_t = section.has("target");
+  if (has_s != has_t)
+    section.fail(has_s ? "source" : "target", "give both source and target points (mm), or neither to use the open ends");
+  if (has_s) {
+    auto s = section.numbers("source", 3), t = section.numbers("target", 3);
+    o.source_point = Eigen::Vector3d(s[0], s[1], s[2]);
+    o.target_point = Eigen::Vector3d(t[0], t[1], t[2]);
+  }
+  o.centering_passes = section.integer("centering_passes", 2, Range::between(0, 10));
+  if (section.has("reference_radius"))
+    o.reference_radius = section.quantity("reference_radius", units::kLength, std::nullopt, Range::positive());
+  o.end_exclusion_radii = section.number("end_exclusion_radii", 1.0, Range::non_negative());
+  if (section.has("true_centerline")) o.true_centerline = section.path("true_centerline");
+  section.finish();
+  return o;
+}
+
+void run_centerline_stage(const CenterlineOptions& options, const std::filesystem::path& lumen_vtp,
+                          const std::filesystem::path& out_centerline_vtp, Summary& summary) {
+  MeshData lumen = read_vtp(lumen_vtp.string());
+  CenterlineResult r;
+  try {
+    r = compute_centerline(lumen, options);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", lumen_vtp.string(), e.what()));
+  }
+  write_vtp(out_centerline_vtp.string(), r.centerline);
+  summary.set("centerline_length", r.length, "mm");
+  summary.set("centerline_points", double(r.centerline.points.size()));
+  summary.set("centerline_spacing", options.spacing, "mm");
+  summary.set("min_radius", r.min_radius, "mm");
+  summary.set("stenosis_abscissa", r.stenosis_abscissa, "mm");
+  summary.set("stenosis_point", std::vector<double>{r.stenosis_point.x(), r.stenosis_point.y(), r.stenosis_point.z()}, "mm");
+  summary.set("reference_radius", r.reference_radius, "mm");
+  summary.set("stenosis_percent_diameter", r.stenosis_percent_diameter, "%");
+  summary.set("voronoi_nodes", double(r.voronoi_nodes));
+  summary.set("lumen_triangles", double(lumen.num_cells()));
+  summary.set("centerline_time_s", r.seconds, "s");
+  summary.note("reference_radius", options.reference_radius ? "given in the case"
+                                                            : "median inscribed radius away from the ends");
+  summary.note("centerline_method", r.centerline.field_text["centerline_method"]);
+  log::info("centerline: {:.2f} mm, narrowest radius {:.4f} mm at {:.2f} mm ({:.1f} % diameter stenosis), {:.2f} s",
+            r.length, r.min_radius, r.stenosis_abscissa, r.stenosis_percent_diameter, r.seconds);
+  if (options.true_centerline) {
+    MeshData truth = read_vtp(options.true_centerline->string());
+    CenterlineAccuracy acc = compare_with_true_centerline(r.centerline, truth);
+    summary.set("centerline_distance_max", acc.centerline_distance_max, "");
+    summary.set("inscribed_radius_error_max", acc.inscribed_radius_error_max, "");
+    summary.set("stenosis_site_error", acc.stenosis_site_error, "mm");
+    summary.note("accuracy", "relative to the local true radius, more than 2 true radii from the ends");
+  }
+}
+
+}  // namespace stentsim::segmentation
