@@ -1,0 +1,54 @@
+#pragma once
+// Global assembly: receives element contributions (Assembler), applies nodal
+// frames and Dirichlet constraints on the fly and builds K (CSR) and R.
+//   - rows of fixed DOFs become identity rows; their residual is kept as the
+//     reaction (reactions()).
+//   - columns of fixed DOFs move to the right-hand side with the prescribed
+//     increment: rhs = -(R + K_fc du_c).
+// The sparsity pattern is kept between assemblies and grows when a term adds
+// a new coupling (contact).
+#include <Eigen/Core>
+
+#include <vector>
+
+#include "solver/assembly/constraints.hpp"
+#include "solver/linalg/csr_matrix.hpp"
+#include "solver/terms/term.hpp"
+
+namespace stentsim::solver {
+
+class GlobalSystem : public Assembler {
+ public:
+  explicit GlobalSystem(const Constraints& constraints);
+
+  /// Start an assembly. `prescribed` holds the increments of fixed DOFs
+  /// (local coordinates) to eliminate; `with_tangent` false assembles R only.
+  void begin(const Eigen::VectorXd& prescribed, bool with_tangent = true);
+  void add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& residual,
+           const Eigen::Ref<const Eigen::MatrixXd>& tangent) override;
+  bool wants_tangent() const override { return with_tangent_; }
+  /// Merge new couplings into the pattern and put the identity on fixed rows.
+  void finish();
+
+  /// Residual in local coordinates, all DOFs (fixed ones hold reactions).
+  const Eigen::VectorXd& residual() const { return residual_; }
+  /// Norm of the residual over free DOFs.
+  double free_residual_norm() const;
+  /// Right-hand side of K du = rhs: -(R + K_fc du_c) at free DOFs, du_c at fixed ones.
+  Eigen::VectorXd rhs() const;
+  const CsrMatrix& matrix() const { return matrix_; }
+
+ private:
+  void insert(GlobalDof row, GlobalDof col, double value);
+
+  const Constraints& constraints_;
+  Eigen::VectorXd residual_, correction_, prescribed_;
+  CsrMatrix matrix_;
+  std::vector<std::tuple<GlobalDof, GlobalDof, double>> pending_;  // entries outside the pattern
+  bool with_tangent_ = true;
+  // scratch for frame rotations (grows, never shrinks: no per-element allocation)
+  Eigen::VectorXd r_scratch_;
+  Eigen::MatrixXd k_scratch_;
+};
+
+}  // namespace stentsim::solver

@@ -1,0 +1,25 @@
+#include "solver/assembly/model.hpp"
+
+namespace stentsim::solver {
+
+void Model::assemble(const Eigen::VectorXd& u, double time, double dt, const Eigen::VectorXd& prescribed,
+                     GlobalSystem& system, bool with_tangent) {
+  system.begin(prescribed, with_tangent);
+  SystemState state{u, time, dt, rank, ranks};
+  for (auto& t : terms) t->assemble(state, system);
+  system.finish();
+}
+
+Eigen::MatrixXd Model::rigid_body_modes(const std::vector<std::pair<GlobalDof, Vec3>>& nodes) const {
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(dofs.size(), 6);
+  for (const auto& [first, x] : nodes) {
+    for (int a = 0; a < 3; ++a) m(first + a, a) = 1.0;
+    // rotations: e_k x X
+    m(first + 1, 3) = -x.z(), m(first + 2, 3) = x.y();
+    m(first + 0, 4) = x.z(), m(first + 2, 4) = -x.x();
+    m(first + 0, 5) = -x.y(), m(first + 1, 5) = x.x();
+  }
+  return m;
+}
+
+}  // namespace stentsim::solver

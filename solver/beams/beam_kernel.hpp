@@ -1,0 +1,194 @@
+#pragma once
+// The Simo–Reissner element energy, residual and tangent (one element).
+//
+// Strains (Simo & Vu-Quoc 1986; paper Section 2.2, App. C):
+//   Γ = Λᵀ r' − Λ₀ᵀ r₀'   (axial, two shear; Λ₀ᵀ r₀' = E₁ for triads aligned with
+//                          the reference tangent — subtracting the interpolated
+//                          reference value keeps curved references exactly
+//                          stress-free, as 4C does),
+//   Ω = K − K₀ with S(K) = Λᵀ Λ' (torsion, two bending),
+//   Π = ∫ ½ (Γ·C_F Γ + Ω·C_M Ω) ds.
+// Variations: additive DOFs x (positions, Hermite tangents) enter r' linearly;
+// nodal triads are perturbed multiplicatively, Λ_i(h_i) = exp(S(h_i)) Λ_i
+// (spatial convention, rotation.hpp). With Π̂(x, h) the energy of the perturbed
+// state, the residual is R = ∇Π̂ at h = 0 and the consistent tangent of the
+// spatial multiplicative update is
+//   K = ∇²Π̂ − ½ blockdiag_i S(∂Π̂/∂h_i)
+// since exp(S(a e_i)) exp(S(ε e_j)) = exp(S(a e_i + ε e_j + ½ a ε e_i × e_j + …))
+// (Baker–Campbell–Hausdorff); K is non-symmetric away from equilibrium.
+// ∇²Π̂ over the rotations comes from Jet<3·NT>; the blocks with x by hand:
+//   ∂Π/∂x_k = ∫ B'_k n ds, n = Λ C_F Γ,  ∂²Π/∂x_k∂x_l = ∫ B'_k B'_l Λ C_F Λᵀ ds,
+//   ∂²Π/∂x_k∂h = ∫ B'_k ∂n/∂h ds.
+#include "solver/beams/element_reference.hpp"
+#include "solver/beams/jet.hpp"
+#include "solver/beams/rotation.hpp"
+#include "solver/beams/section.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+
+namespace stentsim::solver::beams {
+
+/// Crisfield–Jelenić triad field of one element: Λ_r and the local rotation
+/// vectors ψ_i with Λ_r exp(S(ψ_i)) = Λ_i.
+template <class S, int NT>
+struct TriadField {
+  Quat<S> qr;
+  std::array<V3<S>, NT> psi;
+};
+
+template <class S, int NT>
+TriadField<S, NT> triad_field(const std::array<Quat<S>, NT>& q) {
+  TriadField<S, NT> f;
+  if constexpr (NT == 3) {
+    // I = J = the middle node (index 2): Λ_r = Λ_mid, ψ_mid = 0.
+    f.qr = q[2];
+    const Quat<S> rc = qconj(f.qr);
+    f.psi[0] = qlog(qmul(rc, q[0]));
+    f.psi[1] = qlog(qmul(rc, q[1]));
+    f.psi[2] = {S(0.0), S(0.0), S(0.0)};
+  } else {
+    // I = a, J = b: Λ_r = Λ_a exp(½ Φ), Φ = log(Λ_aᵀ Λ_b); ψ_a = −Φ/2, ψ_b = Φ/2.
+    const V3<S> phi = qlog(qmul(qconj(q[0]), q[1]));
+    const V3<S> half{0.5 * phi[0], 0.5 * phi[1], 0.5 * phi[2]};
+    f.qr = qmul(q[0], qexp(half));
+    f.psi[0] = {-half[0], -half[1], -half[2]};
+    f.psi[1] = half;
+  }
+  return f;
+}
+
+/// Λ and K (S(K) = ΛᵀΛ') at a point with triad weights N, dN/ds.
+template <class S, int NT>
+void triad_at(const TriadField<S, NT>& f, const std::array<double, 3>& N, const std::array<double, 3>& dN,
+              M3<S>& Lambda, V3<S>& K) {
+  V3<S> psi{S(0.0), S(0.0), S(0.0)}, dpsi{S(0.0), S(0.0), S(0.0)};
+  for (int i = 0; i < NT; ++i)
+    for (int c = 0; c < 3; ++c) {
+      psi[c] += N[i] * f.psi[i][c];
+      dpsi[c] += dN[i] * f.psi[i][c];
+    }
+  Lambda = qmat(qmul(f.qr, qexp(psi)));
+  K = right_jacobian_times(psi, dpsi);
+}
+
+/// Section state at one point (double): the quantities of objectivity tests and output.
+struct SectionState {
+  double xi = 0.0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d triad = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d Gamma = Eigen::Vector3d::Zero(), Omega = Eigen::Vector3d::Zero();
+  Eigen::Vector3d F = Eigen::Vector3d::Zero(), M = Eigen::Vector3d::Zero();  // material resultants
+};
+
+template <int NC, int NT>
+SectionState section_state(const ShapePoint& p, const BeamSection& sec, const std::array<Eigen::Vector3d, 4>& x,
+                           const std::array<Eigen::Quaterniond, 3>& q) {
+  std::array<Quat<double>, NT> qq;
+  for (int i = 0; i < NT; ++i) qq[i] = qconst<double>(q[i]);
+  const auto f = triad_field<double, NT>(qq);
+  M3<double> L;
+  V3<double> K;
+  triad_at<double, NT>(f, p.N, p.dN, L, K);
+  SectionState s;
+  s.xi = p.xi;
+  Eigen::Vector3d dr = Eigen::Vector3d::Zero();
+  for (int k = 0; k < NC; ++k) {
+    s.position += p.B[k] * x[k];
+    dr += p.dB[k] * x[k];
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) s.triad(i, j) = L[3 * i + j];
+  s.Gamma = s.triad.transpose() * dr - p.Gamma0;
+  s.Omega = Eigen::Vector3d(K[0], K[1], K[2]) - p.Kappa0;
+  s.F = sec.CF.cwiseProduct(s.Gamma);
+  s.M = sec.CM.cwiseProduct(s.Omega);
+  return s;
+}
+
+template <int NC, int NT>
+double element_energy(const ElementReference& ref, const BeamSection& sec, const std::array<Eigen::Vector3d, 4>& x,
+                      const std::array<Eigen::Quaterniond, 3>& q) {
+  double e = 0.0;
+  for (const ShapePoint& p : ref.points) {
+    const SectionState s = section_state<NC, NT>(p, sec, x, q);
+    e += p.weight_ds * 0.5 * (s.Gamma.dot(s.F) + s.Omega.dot(s.M));
+  }
+  return e;
+}
+
+/// Residual and tangent in the split ordering [x_0 … x_{NC−1}, θ_0 … θ_{NT−1}]
+/// (3 components each).
+template <int NC, int NT>
+struct ElementSystem {
+  static constexpr int n = 3 * (NC + NT);
+  Eigen::Matrix<double, n, 1> R = Eigen::Matrix<double, n, 1>::Zero();
+  Eigen::Matrix<double, n, n> K = Eigen::Matrix<double, n, n>::Zero();
+  double energy = 0.0;
+};
+
+template <int NC, int NT>
+void element_system(const ElementReference& ref, const BeamSection& sec, const std::array<Eigen::Vector3d, 4>& x,
+                    const std::array<Eigen::Quaterniond, 3>& q, ElementSystem<NC, NT>& out) {
+  constexpr int NH = 3 * NT;
+  constexpr int NX = 3 * NC;
+  using J = Jet<NH>;
+  // Perturbed nodal triads exp(S(h_i)) Λ_i, h = 0 as Jet variables.
+  std::array<Quat<J>, NT> qq;
+  for (int i = 0; i < NT; ++i) {
+    const V3<J> h{J::variable(0.0, 3 * i), J::variable(0.0, 3 * i + 1), J::variable(0.0, 3 * i + 2)};
+    qq[i] = qmul(qexp_second_order(h), qconst<J>(q[i]));
+  }
+  const auto field = triad_field<J, NT>(qq);
+
+  J energy(0.0);
+  Eigen::Matrix<double, NX, 1> gx = Eigen::Matrix<double, NX, 1>::Zero();
+  Eigen::Matrix<double, NX, NX> Hxx = Eigen::Matrix<double, NX, NX>::Zero();
+  Eigen::Matrix<double, NX, NH> Hxh = Eigen::Matrix<double, NX, NH>::Zero();
+  for (const ShapePoint& p : ref.points) {
+    M3<J> L;
+    V3<J> Kap;
+    triad_at<J, NT>(field, p.N, p.dN, L, Kap);
+    Eigen::Vector3d dr = Eigen::Vector3d::Zero();
+    for (int k = 0; k < NC; ++k) dr += p.dB[k] * x[k];
+    V3<J> Gam, F, M;
+    for (int i = 0; i < 3; ++i) {
+      Gam[i] = L[i] * dr[0] + L[3 + i] * dr[1] + L[6 + i] * dr[2] - p.Gamma0[i];  // (Λᵀ r')_i − Γ₀
+      F[i] = sec.CF[i] * Gam[i];
+      M[i] = sec.CM[i] * (Kap[i] - p.Kappa0[i]);
+    }
+    J pi = 0.5 * (dot(Gam, F) + dot(V3<J>{Kap[0] - p.Kappa0[0], Kap[1] - p.Kappa0[1], Kap[2] - p.Kappa0[2]}, M));
+    pi *= p.weight_ds;
+    energy += pi;
+    // Spatial force n = Λ F, its gradient over h, and Λ C_F Λᵀ.
+    Eigen::Vector3d nv;
+    Eigen::Matrix<double, 3, NH> ng;
+    Eigen::Matrix3d Lv;
+    for (int i = 0; i < 3; ++i) {
+      const J ni = L[3 * i] * F[0] + L[3 * i + 1] * F[1] + L[3 * i + 2] * F[2];
+      nv[i] = ni.v;
+      ng.row(i) = ni.g.transpose();
+      for (int j = 0; j < 3; ++j) Lv(i, j) = L[3 * i + j].v;
+    }
+    const Eigen::Matrix3d C = Lv * sec.CF.asDiagonal() * Lv.transpose();
+    for (int k = 0; k < NC; ++k) {
+      const double wk = p.weight_ds * p.dB[k];
+      gx.template segment<3>(3 * k) += wk * nv;
+      Hxh.template block<3, NH>(3 * k, 0) += wk * ng;
+      for (int l = 0; l < NC; ++l) Hxx.template block<3, 3>(3 * k, 3 * l) += (wk * p.dB[l]) * C;
+    }
+  }
+  out.energy = energy.v;
+  out.R.template head<NX>() = gx;
+  out.R.template tail<NH>() = energy.g;
+  out.K.template topLeftCorner<NX, NX>() = Hxx;
+  out.K.template topRightCorner<NX, NH>() = Hxh;
+  out.K.template bottomLeftCorner<NH, NX>() = Hxh.transpose();
+  Eigen::Matrix<double, NH, NH> Khh = energy.H;
+  for (int i = 0; i < NT; ++i)
+    Khh.template block<3, 3>(3 * i, 3 * i) -= 0.0 * skew(energy.g.template segment<3>(3 * i));
+  out.K.template bottomRightCorner<NH, NH>() = Khh;
+}
+
+}  // namespace stentsim::solver::beams

@@ -1,0 +1,193 @@
+#include "solver/beams/beam_term.hpp"
+
+#include "common/error.hpp"
+
+#include <utility>
+
+namespace stentsim::solver::beams {
+
+namespace {
+
+Eigen::Vector3d read(const Eigen::VectorXd& u, const std::array<GlobalDof, 3>& d) {
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) v[i] = d[i] >= 0 ? u[d[i]] : 0.0;
+  return v;
+}
+
+Eigen::Vector3d reference_tangent(const BeamNode& n) { return n.triad.toRotationMatrix().col(0); }
+
+}  // namespace
+
+std::vector<bool> beam_end_nodes(const BeamBodyDefinition& body) {
+  std::vector<bool> end(body.nodes.size(), false);
+  for (const BeamElement& e : body.elements) {
+    if (e.a >= 0 && e.a < static_cast<int>(end.size())) end[e.a] = true;
+    if (e.b >= 0 && e.b < static_cast<int>(end.size())) end[e.b] = true;
+  }
+  return end;
+}
+
+long long beam_nodal_dof_count(const BeamBodyDefinition& body) {
+  const std::vector<bool> end = beam_end_nodes(body);
+  long long n = 0;
+  for (bool is_end : end) {
+    if (body.interpolation == BeamInterpolation::hermite3)
+      n += is_end ? 9 : 3;
+    else
+      n += is_end ? 6 : 0;
+  }
+  return n;
+}
+
+std::vector<BeamNodeDofs> number_beam_dofs(const BeamBodyDefinition& body, GlobalDof first, GlobalDof* next) {
+  const std::vector<bool> end = beam_end_nodes(body);
+  std::vector<BeamNodeDofs> dofs(body.nodes.size());
+  GlobalDof k = first;
+  const bool hermite = body.interpolation == BeamInterpolation::hermite3;
+  for (std::size_t n = 0; n < dofs.size(); ++n) {
+    if (end[n])
+      for (int i = 0; i < 3; ++i) dofs[n].pos[i] = k++;
+    if (end[n] || hermite)
+      for (int i = 0; i < 3; ++i) dofs[n].rot[i] = k++;
+    if (end[n] && hermite)
+      for (int i = 0; i < 3; ++i) dofs[n].tan[i] = k++;
+  }
+  if (next) *next = k;
+  return dofs;
+}
+
+BeamTerm::BeamTerm(std::string name, BeamBodyDefinition body, std::vector<BeamNodeDofs> dofs)
+    : name_(std::move(name)), body_(std::move(body)), dofs_(std::move(dofs)) {
+  const std::string where = "beam body '" + name_ + "'";
+  body_.section.validate(where);
+  const int nn = static_cast<int>(body_.nodes.size());
+  if (static_cast<int>(dofs_.size()) != nn)
+    throw InputError(where + ": DOF map has " + std::to_string(dofs_.size()) + " nodes, body has " +
+                     std::to_string(nn));
+  const bool hermite = body_.interpolation == BeamInterpolation::hermite3;
+  for (auto& n : body_.nodes) n.triad.normalize();
+  for (std::size_t e = 0; e < body_.elements.size(); ++e) {
+    const BeamElement& el = body_.elements[e];
+    auto bad = [&](int i) { return i < 0 || i >= nn; };
+    if (bad(el.a) || bad(el.b) || (hermite && bad(el.mid)))
+      throw InputError(where + ": element " + std::to_string(e) + " refers to a node outside 0.." +
+                       std::to_string(nn - 1) + (hermite ? " (Hermite elements need a, b and mid)" : ""));
+    const BeamNode &A = body_.nodes[el.a], &B = body_.nodes[el.b];
+    std::array<Eigen::Vector3d, 4> x0{};
+    std::array<Eigen::Quaterniond, 3> q0{A.triad, B.triad, Eigen::Quaterniond::Identity()};
+    if (hermite) {
+      x0 = {A.position, reference_tangent(A), B.position, reference_tangent(B)};
+      q0[2] = body_.nodes[el.mid].triad;
+    } else {
+      x0 = {A.position, B.position, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    }
+    refs_.push_back(make_element_reference(body_.interpolation, x0, q0, body_.gauss_points));
+  }
+  committed_.resize(nn);
+  for (int n = 0; n < nn; ++n) committed_[n] = body_.nodes[n].triad;
+  accepted_ = trial_ = committed_;
+}
+
+std::vector<GlobalDof> BeamTerm::element_dofs(std::size_t e) const {
+  const BeamElement& el = body_.elements[e];
+  std::vector<GlobalDof> d;
+  auto add = [&](const std::array<GlobalDof, 3>& a) { d.insert(d.end(), a.begin(), a.end()); };
+  if (body_.interpolation == BeamInterpolation::hermite3) {
+    add(dofs_[el.a].pos), add(dofs_[el.a].tan), add(dofs_[el.b].pos), add(dofs_[el.b].tan);
+    add(dofs_[el.a].rot), add(dofs_[el.b].rot), add(dofs_[el.mid].rot);
+  } else {
+    add(dofs_[el.a].pos), add(dofs_[el.b].pos), add(dofs_[el.a].rot), add(dofs_[el.b].rot);
+  }
+  return d;
+}
+
+void BeamTerm::gather(const Eigen::VectorXd& u, std::size_t e, std::array<Eigen::Vector3d, 4>& x,
+                      std::array<Eigen::Quaterniond, 3>& q) const {
+  const BeamElement& el = body_.elements[e];
+  const ElementReference& r = refs_[e];
+  if (body_.interpolation == BeamInterpolation::hermite3) {
+    x = {r.x0[0] + read(u, dofs_[el.a].pos), r.x0[1] + read(u, dofs_[el.a].tan), r.x0[2] + read(u, dofs_[el.b].pos),
+         r.x0[3] + read(u, dofs_[el.b].tan)};
+    q = {trial_[el.a], trial_[el.b], trial_[el.mid]};
+  } else {
+    x = {r.x0[0] + read(u, dofs_[el.a].pos), r.x0[1] + read(u, dofs_[el.b].pos), Eigen::Vector3d::Zero(),
+         Eigen::Vector3d::Zero()};
+    q = {trial_[el.a], trial_[el.b], Eigen::Quaterniond::Identity()};
+  }
+}
+
+void BeamTerm::assemble(const SystemState& state, Assembler& out) {
+  const std::size_t ne = body_.elements.size();
+  std::array<Eigen::Vector3d, 4> x;
+  std::array<Eigen::Quaterniond, 3> q;
+  for (std::size_t e = 0; e < ne; ++e) {
+    if (!state.owns(e, ne)) continue;
+    gather(state.u, e, x, q);
+    const std::vector<GlobalDof> d = element_dofs(e);
+    if (body_.interpolation == BeamInterpolation::hermite3) {
+      ElementSystem<4, 3> s;
+      element_system<4, 3>(refs_[e], body_.section, x, q, s);
+      out.add(d, s.R, s.K);
+    } else {
+      ElementSystem<2, 2> s;
+      element_system<2, 2>(refs_[e], body_.section, x, q, s);
+      out.add(d, s.R, s.K);
+    }
+  }
+}
+
+void BeamTerm::trial(const Eigen::VectorXd& du) {
+  for (std::size_t n = 0; n < trial_.size(); ++n) {
+    const Eigen::Vector3d dth = read(du, dofs_[n].rot);
+    trial_[n] = (quat_exp(dth) * accepted_[n]).normalized();
+  }
+}
+void BeamTerm::accept() { accepted_ = trial_; }
+void BeamTerm::commit() { committed_ = accepted_; }
+void BeamTerm::rollback() { accepted_ = trial_ = committed_; }
+
+void BeamTerm::set_rotation(int node, const Eigen::Quaterniond& q) {
+  trial_.at(node) = q.normalized();
+  accepted_[node] = trial_[node];
+}
+
+Eigen::Vector3d BeamTerm::position(const Eigen::VectorXd& u, int node) const {
+  return body_.nodes.at(node).position + read(u, dofs_[node].pos);
+}
+Eigen::Vector3d BeamTerm::tangent(const Eigen::VectorXd& u, int node) const {
+  return reference_tangent(body_.nodes.at(node)) + read(u, dofs_[node].tan);
+}
+
+SectionState BeamTerm::sample(const Eigen::VectorXd& u, std::size_t e, double xi) const {
+  std::array<Eigen::Vector3d, 4> x;
+  std::array<Eigen::Quaterniond, 3> q;
+  gather(u, e, x, q);
+  const ShapePoint p = refs_[e].at(xi);
+  return body_.interpolation == BeamInterpolation::hermite3 ? section_state<4, 3>(p, body_.section, x, q)
+                                                            : section_state<2, 2>(p, body_.section, x, q);
+}
+
+std::vector<SectionState> BeamTerm::section_states(const Eigen::VectorXd& u, std::size_t e) const {
+  std::array<Eigen::Vector3d, 4> x;
+  std::array<Eigen::Quaterniond, 3> q;
+  gather(u, e, x, q);
+  std::vector<SectionState> s;
+  for (const ShapePoint& p : refs_[e].points)
+    s.push_back(body_.interpolation == BeamInterpolation::hermite3 ? section_state<4, 3>(p, body_.section, x, q)
+                                                                   : section_state<2, 2>(p, body_.section, x, q));
+  return s;
+}
+
+double BeamTerm::energy(const Eigen::VectorXd& u) const {
+  double E = 0.0;
+  std::array<Eigen::Vector3d, 4> x;
+  std::array<Eigen::Quaterniond, 3> q;
+  for (std::size_t e = 0; e < body_.elements.size(); ++e) {
+    gather(u, e, x, q);
+    E += body_.interpolation == BeamInterpolation::hermite3 ? element_energy<4, 3>(refs_[e], body_.section, x, q)
+                                                            : element_energy<2, 2>(refs_[e], body_.section, x, q);
+  }
+  return E;
+}
+
+}  // namespace stentsim::solver::beams

@@ -1,0 +1,106 @@
+#pragma once
+// A body of geometrically exact Simo–Reissner beam elements as one Term
+// (solver/terms/term.hpp): it adds residual and tangent over its DOFs and owns
+// the nodal triads, which it updates multiplicatively.
+//
+// Rotation increments: spatial (left) convention, Λ <- exp(S(Δθ)) Λ, stored as
+// quaternions q <- qexp(Δθ) ⊗ q (Simo & Vu-Quoc 1986, eq. 2.6; term.hpp). The
+// residual at a rotation DOF is the work conjugate of a spatial virtual
+// rotation δθ (δΛ = S(δθ) Λ), and the tangent is its derivative along this
+// update (beam_kernel.hpp).
+//
+// Additive DOFs in the global vector u: positions r = X + u (end nodes),
+// Hermite tangents t = T₀ + u (end nodes, T₀ = d1 of the reference triad).
+#include "solver/beams/beam_kernel.hpp"
+#include "solver/beams/element_reference.hpp"
+#include "solver/beams/section.hpp"
+#include "solver/terms/term.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace stentsim::solver::beams {
+
+struct BeamNode {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond triad = Eigen::Quaterniond::Identity();  // reference Λ₀ = [d1 d2 d3], d1 = tangent
+};
+
+/// Element connectivity: end nodes a, b; Hermite elements also a middle node
+/// (rotation only, at ξ = 0).
+struct BeamElement {
+  int a = -1, b = -1, mid = -1;
+};
+
+struct BeamBodyDefinition {
+  BeamInterpolation interpolation = BeamInterpolation::hermite3;
+  std::vector<BeamNode> nodes;
+  std::vector<BeamElement> elements;
+  BeamSection section;
+  int gauss_points = 0;  // 0: default of the interpolation
+};
+
+/// Global DOFs of one node; −1 = fixed (homogeneous Dirichlet) or absent
+/// (middle nodes have only `rot`; Lagrange nodes have no `tan`).
+struct BeamNodeDofs {
+  std::array<GlobalDof, 3> pos{-1, -1, -1}, rot{-1, -1, -1}, tan{-1, -1, -1};
+};
+
+/// Does node `n` carry positions and tangents (an end node) or only a rotation?
+std::vector<bool> beam_end_nodes(const BeamBodyDefinition& body);
+/// Number of nodal DOFs before constraints: 9 per Hermite end node, 3 per
+/// middle node, 6 per Lagrange node (DESIGN.md §2).
+long long beam_nodal_dof_count(const BeamBodyDefinition& body);
+/// Consecutive DOF numbers starting at `first` (test helper and a default for
+/// the solver core's DOF map); returns the next free number in `next`.
+std::vector<BeamNodeDofs> number_beam_dofs(const BeamBodyDefinition& body, GlobalDof first, GlobalDof* next);
+
+class BeamTerm : public Term {
+ public:
+  BeamTerm(std::string name, BeamBodyDefinition body, std::vector<BeamNodeDofs> dofs);
+
+  std::string name() const override { return name_; }
+  void assemble(const SystemState& state, Assembler& out) override;
+  void trial(const Eigen::VectorXd& du) override;
+  void accept() override;
+  void commit() override;
+  void rollback() override;
+
+  const BeamBodyDefinition& body() const { return body_; }
+  const std::vector<BeamNodeDofs>& dofs() const { return dofs_; }
+  const ElementReference& reference(std::size_t e) const { return refs_[e]; }
+  /// Global DOFs of element e in the kernel's split order
+  /// [x_0 … x_{NC−1}, θ_0 … θ_{NT−1}] (see beam_kernel.hpp).
+  std::vector<GlobalDof> element_dofs(std::size_t e) const;
+
+  /// Current (trial) triad of a node.
+  Eigen::Quaterniond rotation(int node) const { return trial_[node]; }
+  /// Prescribes a node's triad (non-homogeneous rotation Dirichlet, or a test
+  /// state): sets the trial and accepted triads; commit() makes it history.
+  void set_rotation(int node, const Eigen::Quaterniond& q);
+  Eigen::Vector3d position(const Eigen::VectorXd& u, int node) const;
+  Eigen::Vector3d tangent(const Eigen::VectorXd& u, int node) const;
+
+  /// Section states at the quadrature points of element e.
+  std::vector<SectionState> section_states(const Eigen::VectorXd& u, std::size_t e) const;
+  /// Section state at any ξ ∈ [−1, 1] of element e (output sampling).
+  SectionState sample(const Eigen::VectorXd& u, std::size_t e, double xi) const;
+  /// Elastic energy of the body at u and the current triads.
+  double energy(const Eigen::VectorXd& u) const;
+
+ private:
+  void gather(const Eigen::VectorXd& u, std::size_t e, std::array<Eigen::Vector3d, 4>& x,
+              std::array<Eigen::Quaterniond, 3>& q) const;
+
+  std::string name_;
+  BeamBodyDefinition body_;
+  std::vector<BeamNodeDofs> dofs_;
+  std::vector<ElementReference> refs_;
+  std::vector<Eigen::Quaterniond> committed_, accepted_, trial_;
+};
+
+}  // namespace stentsim::solver::beams

@@ -1,0 +1,53 @@
+#pragma once
+// The linear-solver interface the nonlinear solver sees. Implementations:
+// Trilinos (Amesos2 KLU2 direct; Belos GMRES with Ifpack2 ILU(k) or MueLu AMG;
+// trilinos_solvers.cpp, the only C++17 file) and Eigen's SparseLU as a
+// dependency-light reference.
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+
+#include "solver/linalg/csr_matrix.hpp"
+
+namespace stentsim::solver {
+
+struct LinearSolverSettings {
+  /// "direct" (Amesos2 KLU2), "gmres_ilu" (Belos GMRES + Ifpack2 RILUK),
+  /// "gmres_amg" (Belos GMRES + MueLu SA-AMG, rigid-body near-null space), "eigen_lu".
+  std::string type = "direct";
+  double tolerance = 1e-10;   // relative residual of the Krylov solver
+  int max_iterations = 2000;
+  int krylov_size = 200;      // the paper's choice
+  int ilu_fill = 4;           // the paper's choice
+  int verbosity = 0;
+};
+
+struct LinearSolveStats {
+  int iterations = 0;        // 1 for direct solvers
+  double relative_residual = 0.0;
+  bool converged = false;
+  double setup_seconds = 0.0, solve_seconds = 0.0;
+};
+
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+  /// Solves A x = b. `a` holds this rank's contributions (summed over ranks
+  /// by the solver); `b` is the full right-hand side (identical on all ranks);
+  /// `x` receives the full solution on every rank.
+  virtual LinearSolveStats solve(const CsrMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
+  /// Near-null space for AMG (n x k, e.g. the 6 rigid-body modes); ignored by others.
+  virtual void set_near_null_space(const Eigen::MatrixXd& modes) {}
+  virtual std::string describe() const = 0;
+};
+
+/// Throws std::invalid_argument for an unknown type.
+std::unique_ptr<LinearSolver> make_linear_solver(const LinearSolverSettings& settings);
+
+/// The Eigen SparseLU reference solver (single rank).
+std::unique_ptr<LinearSolver> make_eigen_lu_solver();
+/// Trilinos solvers ("direct", "gmres_ilu", "gmres_amg").
+std::unique_ptr<LinearSolver> make_trilinos_solver(const LinearSolverSettings& settings);
+
+}  // namespace stentsim::solver

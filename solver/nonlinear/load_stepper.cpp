@@ -1,0 +1,65 @@
+#include "solver/nonlinear/load_stepper.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "common/error.hpp"
+#include "common/log.hpp"
+
+namespace stentsim::solver {
+
+void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Eigen::VectorXd& u,
+                    const StepperSettings& s, const NewtonSettings& newton,
+                    const std::function<void(const StepRecord&)>& on_step) {
+  std::vector<double> stops = s.stops;
+  stops.push_back(s.t_end);
+  std::sort(stops.begin(), stops.end());
+  const double eps = 1e-12 * std::max(1.0, std::abs(s.t_end));
+  double t = s.t_start, dt = std::min(s.dt_initial, s.dt_max);
+  int step = 0;
+  const auto run_start = std::chrono::steady_clock::now();
+  while (t < s.t_end - eps) {
+    const double next_stop = *std::upper_bound(stops.begin(), stops.end(), t + eps);
+    int cuts = 0;
+    StepRecord rec;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (;;) {
+      double h = std::min(dt, next_stop - t);
+      if (next_stop - (t + h) < 0.01 * h) h = next_stop - t;  // no sliver steps before a stop
+      NewtonResult nr = newton_step(model, system, linear, u, t + h, h, newton);
+      rec.newton_iterations += nr.iterations;
+      rec.linear_iterations += nr.linear_iterations;
+      rec.assembly_seconds += nr.assembly_seconds;
+      rec.linear_seconds += nr.linear_seconds;
+      if (nr.converged) {
+        model.commit();
+        t += h;
+        rec.dt = h;
+        rec.residual_norms = nr.residual_norms;
+        if (nr.iterations <= s.easy_iterations && cuts == 0) dt = std::min(dt * s.grow_factor, s.dt_max);
+        break;
+      }
+      model.rollback();
+      ++cuts;
+      dt = h * s.cut_factor;
+      log::warn("step at t = {:.6g} (dt = {:.3g}) failed: {}; cutting to dt = {:.3g}", t + h, h, nr.failure, dt);
+      if (cuts > s.max_cuts || dt < s.dt_min)
+        throw ComputeError(fmt::format("load stepping stopped at t = {:.6g}: the step of size {:.3g} failed after {} cuts "
+                                       "(dt_min = {:.3g}, max_cuts = {}); last reason: {}",
+                                       t, h, cuts, s.dt_min, s.max_cuts, nr.failure));
+    }
+    rec.step = ++step;
+    rec.time = t;
+    rec.cuts = cuts;
+    rec.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+    const double eta = t > s.t_start ? elapsed * (s.t_end - t) / (t - s.t_start) : 0.0;
+    log::info("step {} t = {:.4g} dt = {:.3g}: {} Newton its, {} linear its, {} cuts, {:.2f} s, ETA {:.0f} s", step, t,
+              rec.dt, rec.newton_iterations, rec.linear_iterations, cuts, rec.wall_seconds, eta);
+    on_step(rec);
+  }
+}
+
+}  // namespace stentsim::solver

@@ -1,0 +1,41 @@
+#pragma once
+// Adaptive load stepping in pseudo-time: a step that fails (no convergence,
+// too many iterations, an element that cannot be evaluated) is rolled back
+// and cut; easy steps let the step grow. Steps end exactly on `stops` (phase
+// ends, output times). On final failure it throws ComputeError naming the
+// time, the step size and the last reason, after the caller's state holds the
+// last converged solution.
+#include <Eigen/Core>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/nonlinear/newton.hpp"
+
+namespace stentsim::solver {
+
+struct StepperSettings {
+  double t_start = 0.0, t_end = 1.0;
+  double dt_initial = 0.1, dt_min = 1e-5, dt_max = 0.1;
+  int max_cuts = 8;            // consecutive cuts before giving up
+  double cut_factor = 0.5, grow_factor = 1.5;
+  int easy_iterations = 5;     // grow after a step with at most this many Newton iterations
+  std::vector<double> stops;   // times a step must end on
+};
+
+struct StepRecord {
+  int step = 0;
+  double time = 0.0, dt = 0.0;
+  int newton_iterations = 0, linear_iterations = 0, cuts = 0;
+  double wall_seconds = 0.0, assembly_seconds = 0.0, linear_seconds = 0.0;
+  std::vector<double> residual_norms;
+};
+
+/// Runs from t_start to t_end. `on_step` is called after each converged and
+/// committed step (u holds the new state).
+void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Eigen::VectorXd& u,
+                    const StepperSettings& stepping, const NewtonSettings& newton,
+                    const std::function<void(const StepRecord&)>& on_step);
+
+}  // namespace stentsim::solver

@@ -1,0 +1,38 @@
+#pragma once
+// Newton-Raphson for one load step with a backtracking line search on the
+// free-DOF residual norm. A trial state that a term cannot evaluate
+// (ElementFailure: inverted element, overflow, NaN) is backtracked; if no
+// trial works the step fails and the stepper cuts it (DESIGN.md §7).
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+#include "solver/assembly/model.hpp"
+#include "solver/linalg/linear_solver.hpp"
+
+namespace stentsim::solver {
+
+struct NewtonSettings {
+  int max_iterations = 20;
+  double residual_tolerance = 1e-8;   // relative to the step's force scale
+  double residual_absolute = 1e-10;   // N
+  double increment_tolerance = 1e-8;  // relative to |u|
+  int line_search_steps = 6;          // halvings
+};
+
+struct NewtonResult {
+  bool converged = false;
+  int iterations = 0;
+  int linear_iterations = 0;
+  std::vector<double> residual_norms;  // free-DOF residual, per iteration (index 0 = before the first solve)
+  std::string failure;                 // why it failed (last element failure or divergence)
+  double assembly_seconds = 0.0, linear_seconds = 0.0;
+};
+
+/// Solves the step ending at `time` (size dt) starting from u (updated in
+/// place on success; left at the start value on failure).
+NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linear, Eigen::VectorXd& u, double time,
+                         double dt, const NewtonSettings& settings);
+
+}  // namespace stentsim::solver
