@@ -16,6 +16,7 @@ int dispatch(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands()) {
     auto it = handlers().find(sub);
     if (it != handlers().end()) return it->second();
+    if (!sub->get_subcommands().empty()) return dispatch(*sub);  // e.g. `cohort run`
   }
   return 2;
 }

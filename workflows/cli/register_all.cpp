@@ -5,10 +5,12 @@ namespace stentsim::cli {
 void register_version(CLI::App& app);
 void register_run(CLI::App& app);
 void register_init(CLI::App& app);
+void register_cohort(CLI::App& app);
 
 void register_all(CLI::App& app) {
   register_init(app);
   register_run(app);
+  register_cohort(app);
   register_version(app);
 }
 

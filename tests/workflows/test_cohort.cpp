@@ -1,0 +1,124 @@
+// `stentsim cohort`: validation before anything runs, local workers, a second
+// run that skips, case selection, expected failures and the summary CSV.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "common/files.hpp"
+#include "workflows/cohort/cohort_runner.hpp"
+
+namespace fs = std::filesystem;
+using stentsim::files::read_text;
+using stentsim::files::write_atomic;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string out;
+};
+
+Result sh(const std::string& args) {
+  std::string cmd = std::string(STENTSIM_TEST_BINARY) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  int status = ::pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+class Cohort : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() / ("stentsim-cohort-" + std::to_string(::getpid()) + "-" +
+                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    ASSERT_EQ(sh("init " + dir.string() + " --scene generic-artery").code, 0);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  std::string cohort(const std::string& cases) {
+    const fs::path f = dir / "cohort.yaml";
+    write_atomic(f, "name: t\ntemplate: generic-artery.yaml\nworkers: 2\ncases:\n" + cases);
+    return f.string();
+  }
+  fs::path dir;
+};
+
+TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
+  const auto f = cohort(
+      "  - id: coarse\n    overrides: {mesh: {generic: {elements_around: 16, elements_along: 4}}}\n"
+      "  - id: fine\n    overrides: {mesh: {generic: {elements_around: 24, elements_along: 6}}}\n"
+      "  - id: other\n    overrides: {mesh: {generic: {elements_around: 20, elements_along: 5}}}\n");
+  auto r = sh("cohort run " + f);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << r.out;
+  const auto csv = read_text(dir / "cohort.work/cohort_summary.csv");
+  EXPECT_NE(csv.find("\"coarse\",\"done\""), std::string::npos) << csv;
+  EXPECT_NE(csv.find("mesh.artery_elements"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"256\""), std::string::npos) << csv;  // 16 x 4 x 4 hex8 for `coarse`
+  // Second run: every case's stages are up to date.
+  r = sh("cohort run " + f);
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* id : {"coarse", "fine", "other"}) {
+    const auto log = read_text(dir / "cohort.work" / id / "run.log");
+    EXPECT_NE(log.find("0 ran, 2 up to date"), std::string::npos) << log;
+  }
+  r = sh("cohort status " + f);
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("coarse"), std::string::npos);
+  EXPECT_EQ(r.out.find("stale"), std::string::npos) << r.out;
+}
+
+TEST_F(Cohort, SelectsCasesAndPassesRunnerOptions) {
+  const auto f = cohort("  - id: a\n  - id: b\n");
+  auto r = sh("cohort run " + f + " --cases b --until mesh --workers 1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/a/work/manifest.yaml"));
+  EXPECT_TRUE(fs::exists(dir / "cohort.work/b/work/mesh/artery.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/b/work/fibers"));
+  r = sh("cohort run " + f + " --cases nope");
+  EXPECT_EQ(r.code, 2) << r.out;
+}
+
+TEST_F(Cohort, UnexpectedOutcomeExitsOne) {
+  // A case declared to fail at `mesh` that succeeds is reported and counted.
+  const auto f = cohort("  - id: ok\n  - id: odd\n    expect_failure: mesh\n");
+  auto r = sh("cohort run " + f);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("odd: succeeded unexpectedly"), std::string::npos) << r.out;
+  EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.csv").find("\"odd\",\"succeeded unexpectedly\""), std::string::npos);
+}
+
+TEST_F(Cohort, BadCohortFilesStopBeforeAnythingRuns) {
+  auto r = sh("cohort run " + cohort("  - id: a\n  - id: a\n"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("duplicate case id 'a'"), std::string::npos) << r.out;
+  r = sh("cohort run " + cohort("  - id: a\n    overrides: {mesh: {sise: 1 mm}}\n"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("case 'a': mesh.sise: unknown key"), std::string::npos) << r.out;
+  r = sh("cohort run " + cohort("  - id: a\n    expect_failure: meshing\n"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("'meshing' is not one of"), std::string::npos) << r.out;
+  write_atomic(dir / "missing.yaml", "template: nowhere.yaml\ncases:\n  - id: a\n");
+  r = sh("cohort run " + (dir / "missing.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("nowhere.yaml: file not found"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "cohort.work"));
+}
+
+TEST(CohortSlots, NeverOversubscribeCores) {
+  using stentsim::workflows::concurrent_cases;
+  EXPECT_EQ(concurrent_cases(4, 1, 2), 2);
+  EXPECT_EQ(concurrent_cases(4, 2, 2), 1);
+  EXPECT_EQ(concurrent_cases(1, 1, 8), 1);
+  EXPECT_EQ(concurrent_cases(8, 4, 2), 1);  // at least one
+}
+
+}  // namespace

@@ -1,0 +1,111 @@
+// `stentsim cohort run|status COHORT.yaml`: many cases with one command.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <iostream>
+
+#include "common/error.hpp"
+#include "pipeline/runner.hpp"
+#include "workflows/case_config.hpp"
+#include "workflows/case_stages.hpp"
+#include "workflows/cli/commands.hpp"
+#include "workflows/cohort/cohort_runner.hpp"
+#include "workflows/version.hpp"
+
+namespace stentsim::cli {
+namespace {
+
+std::string self_binary() {
+  char buf[4096];
+  ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) throw ComputeError("cannot find the stentsim executable (/proc/self/exe)");
+  return std::string(buf, static_cast<std::size_t>(n));
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= s.size()) {
+    auto end = s.find(',', start);
+    if (end == std::string::npos) end = s.size();
+    if (end > start) out.push_back(s.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+int cohort_status(const std::string& file) {
+  const auto c = workflows::load_cohort(file);
+  const auto case_files = workflows::materialize_cases(c);
+  std::cout << fmt::format("{:<20}", "case");
+  for (const auto& s : workflows::all_stage_names()) std::cout << fmt::format(" {:<12}", s);
+  std::cout << "\n";
+  for (std::size_t i = 0; i < c.cases.size(); ++i) {
+    const auto cc = workflows::load_case(case_files[i]);
+    pipeline::Runner r(pipeline::Plan(workflows::stages_for(cc), cc.work_dir), kVersion);
+    std::map<std::string, std::string> state;
+    for (const auto& st : r.status())
+      state[st.name] = st.state == pipeline::StageState::up_to_date ? "done"
+                       : st.state == pipeline::StageState::failed  ? "failed"
+                       : st.state == pipeline::StageState::stale   ? "stale"
+                                                                   : "-";
+    std::cout << fmt::format("{:<20}", c.cases[i].id);
+    for (const auto& s : workflows::all_stage_names())
+      std::cout << fmt::format(" {:<12}", state.count(s) ? state[s] : "");
+    std::cout << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_cohort(CLI::App& app) {
+  auto* cohort = app.add_subcommand("cohort", "Run many cases (a cohort) with one command");
+  cohort->require_subcommand(1);
+  struct Args {
+    std::string file, cases, until, only;
+    std::vector<std::string> force;
+    bool dry_run = false;
+    int workers = 0;
+  };
+  auto a = std::make_shared<Args>();
+  auto* run = cohort->add_subcommand("run", "Run every case's pipeline incrementally on local workers");
+  run->add_option("cohort", a->file, "Cohort file (YAML)")->required();
+  run->add_option("--workers", a->workers, "Worker processes (default: the cohort file's, else the core count)")
+      ->check(CLI::Range(1, 1024));
+  run->add_option("--cases", a->cases, "Only these case ids (comma-separated)");
+  run->add_option("--until", a->until, "Run each case until this stage");
+  run->add_option("--only", a->only, "Run only this stage of each case");
+  auto* force = run->add_option("--force", a->force, "Re-run every stage, or only STAGE")->expected(0, 1);
+  run->add_flag("--dry-run", a->dry_run, "Print each case's plan; run nothing");
+  on(run, [a, force] {
+    const auto c = workflows::load_cohort(a->file);
+    workflows::CohortRunOptions o;
+    o.workers = a->workers;
+    o.only_cases = split(a->cases);
+    o.binary = self_binary();
+    if (!a->until.empty()) o.run_args.insert(o.run_args.end(), {"--until", a->until});
+    if (!a->only.empty()) o.run_args.insert(o.run_args.end(), {"--only", a->only});
+    if (force->count()) {
+      o.run_args.push_back("--force");
+      if (!a->force.empty()) o.run_args.push_back(a->force[0]);
+    }
+    if (a->dry_run) o.run_args.push_back("--dry-run");
+    const auto rep = workflows::run_cohort(c, o, std::cout);
+    workflows::write_cohort_summary(c, rep);
+    std::cout << fmt::format("{} cases: {} as expected, {} unexpected failures; summary: {}\n", rep.cases.size(),
+                             rep.cases.size() - static_cast<std::size_t>(rep.unexpected()), rep.unexpected(),
+                             (c.work_dir / "cohort_summary.csv").string());
+    for (const auto& r : rep.cases)
+      if (!r.as_expected())
+        std::cerr << fmt::format("  {}: {}{}: {}\n  log: {}\n", r.id, r.status, r.failed_stage.empty() ? "" : " at " + r.failed_stage,
+                                 r.message, (c.work_dir / r.id / "run.log").string());
+    return rep.exit_code();
+  });
+  auto file = std::make_shared<std::string>();
+  auto* status = cohort->add_subcommand("status", "Table of cases x stages (done, stale, failed)");
+  status->add_option("cohort", *file, "Cohort file (YAML)")->required();
+  on(status, [file] { return cohort_status(*file); });
+}
+
+}  // namespace stentsim::cli

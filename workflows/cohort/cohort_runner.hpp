@@ -1,0 +1,46 @@
+#pragma once
+// Runs a cohort's cases with the same incremental runner as one case, on a
+// pool of local worker processes (each `stentsim run` of one case), records
+// each case's outcome and writes cohort_summary.csv.
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "workflows/cohort/cohort_config.hpp"
+
+namespace stentsim::workflows {
+
+struct CohortRunOptions {
+  int workers = 0;                      // 0: from the cohort file, else the core count
+  std::vector<std::string> only_cases;  // --cases
+  std::vector<std::string> run_args;    // passed to each `stentsim run` (--until, --only, --force, --dry-run)
+  std::string binary;                   // the stentsim executable
+};
+
+struct CaseOutcome {
+  std::string id;
+  std::string status;        // done | failed | failed as expected | succeeded unexpectedly
+  std::string failed_stage;  // from the case's manifest
+  std::string message;       // last lines of the case's log on failure
+  int exit_code = 0;
+  double wall_s = 0;
+  bool as_expected() const { return status == "done" || status == "failed as expected"; }
+};
+
+struct CohortReport {
+  std::vector<CaseOutcome> cases;
+  int unexpected() const;
+  int exit_code() const { return unexpected() ? 1 : 0; }
+};
+
+/// Concurrent cases: min(workers, cores / ranks_per_case), at least 1.
+int concurrent_cases(int workers, int ranks_per_case, int cores);
+
+CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out);
+
+/// Writes <work_dir>/cohort_summary.csv: one row per case with status,
+/// failed stage, message and every QoI of its stages' summary.yaml files.
+void write_cohort_summary(const CohortConfig& c, const CohortReport& r);
+
+}  // namespace stentsim::workflows
