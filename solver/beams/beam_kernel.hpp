@@ -187,7 +187,7 @@ void element_system(const ElementReference& ref, const BeamSection& sec, const s
   out.K.template bottomLeftCorner<NH, NX>() = Hxh.transpose();
   Eigen::Matrix<double, NH, NH> Khh = energy.H;
   for (int i = 0; i < NT; ++i)
-    Khh.template block<3, 3>(3 * i, 3 * i) -= 0.0 * skew(energy.g.template segment<3>(3 * i));
+    Khh.template block<3, 3>(3 * i, 3 * i) -= 0.5 * skew(energy.g.template segment<3>(3 * i));
   out.K.template bottomRightCorner<NH, NH>() = Khh;
 }
 
