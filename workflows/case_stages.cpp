@@ -6,6 +6,7 @@
 #include "common/mesh_tags.hpp"
 #include "fibers/analytic_tube_fibers.hpp"
 #include "meshing/generic_artery.hpp"
+#include "segmentation_io/centerline.hpp"
 #include "segmentation_io/phantom.hpp"
 
 namespace stentsim::workflows {
@@ -67,6 +68,25 @@ Stage phantom_segmentation_stage(const CaseConfig& c) {
   return s;
 }
 
+Stage centerline_stage(const CaseConfig& c) {
+  Stage s;
+  s.name = "centerline";
+  // The phantom's true centerline is an input too: the stage reports its
+  // accuracy against it (inscribed_radius_error_max, stenosis_site_error).
+  s.inputs = {"segmentation/lumen.vtp", "segmentation/centerline_true.vtp"};
+  s.outputs = {"centerline/centerline.vtp"};
+  s.config = slice(c, {"centerline"});
+  s.version = "1";
+  ConfigMap section(c.section("centerline"), std::make_shared<const std::filesystem::path>(c.file), "centerline");
+  segmentation::CenterlineOptions options = segmentation::parse_centerline_options(section);
+  s.run = [options](StageContext& ctx) mutable {
+    options.true_centerline = ctx.input("segmentation/centerline_true.vtp");
+    segmentation::run_centerline_stage(options, ctx.input("segmentation/lumen.vtp"),
+                                       ctx.output("centerline/centerline.vtp"), ctx.summary());
+  };
+  return s;
+}
+
 }  // namespace
 
 const std::vector<std::string>& all_stage_names() {
@@ -86,6 +106,7 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
       break;
     case Scene::patient:
       stages.push_back(phantom_segmentation_stage(c));
+      stages.push_back(centerline_stage(c));
       break;
   }
   return stages;
