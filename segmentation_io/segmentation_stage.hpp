@@ -1,0 +1,59 @@
+#pragma once
+// The segmentation stage (DESIGN.md §1): from what the user brings — a
+// phantom spec or segmented surfaces — to clean lumen.vtp and wall.vtp in mm.
+#include <filesystem>
+#include <optional>
+#include <variant>
+
+#include "common/config.hpp"
+#include "common/summary.hpp"
+#include "segmentation_io/phantom.hpp"
+#include "segmentation_io/surface_input.hpp"
+
+namespace stentsim::segmentation {
+
+/// Outer wall made from the lumen alone (issue 3): a tube of circles normal to
+/// the lumen centerline with radius R_ref + t + remodeling·(R_ref − r)₊, never
+/// closer than t/2 to the lumen; R_ref is the centerline's healthy reference
+/// radius, r the local inscribed radius, so the plaque fills the space between.
+struct WallSynthesisOptions {
+  double wall_thickness = 0.5;  // mm, healthy wall
+  double remodeling = 0.0;      // outward growth of the outer wall per mm of plaque (0: none, 1: full)
+  int circumferential_points = 64;
+};
+
+struct SurfaceInput {
+  std::filesystem::path lumen;
+  std::optional<std::filesystem::path> wall;  // absent: synthesized
+  SurfaceCheckOptions checks;                 // units, repair, open ends
+  WallSynthesisOptions synthesis;
+};
+
+/// Reads an `input.surface:` section: lumen (path), wall (path, optional),
+/// units (mm|cm|m|um), repair (bool), open_ends (int), wall_thickness
+/// (length), remodeling (number). Calls section.finish().
+SurfaceInput parse_surface_input(ConfigMap& section);
+
+/// What an `input:` section holds: exactly one of `phantom:` or `surface:`.
+struct SegmentationInput {
+  std::variant<PhantomSpec, SurfaceInput> source;
+  bool is_phantom() const { return std::holds_alternative<PhantomSpec>(source); }
+};
+/// Reads the case's `input:` section (calls finish() on it and its child).
+SegmentationInput parse_segmentation_input(ConfigMap& input);
+
+/// Runs the stage. For a phantom, `out_true_centerline` (when not empty)
+/// receives the exact centerline too. Summary QoIs: triangle counts, repair
+/// counts, open ends, wall source; for phantoms those of write_phantom.
+void run_segmentation_stage(const SegmentationInput& input, const std::filesystem::path& out_lumen_vtp,
+                            const std::filesystem::path& out_wall_vtp, Summary& summary,
+                            const std::filesystem::path& out_true_centerline = {});
+
+/// Reads and checks one surface file (units scaled to mm).
+TriSurface load_checked_surface(const std::filesystem::path& file, const SurfaceCheckOptions& checks,
+                                SurfaceReport& report);
+
+/// The synthesized outer wall for a lumen (open tube, outward normals).
+TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& options);
+
+}  // namespace stentsim::segmentation

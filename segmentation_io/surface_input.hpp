@@ -1,0 +1,56 @@
+#pragma once
+// Segmented surfaces as users bring them (issue 3): reading through VTK's
+// readers, unit handling, and the checks and repairs that make them usable.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "segmentation_io/triangle_surface.hpp"
+
+namespace stentsim::segmentation {
+
+/// Reads a surface from .vtp, legacy .vtk, .stl (ASCII or binary) or .obj;
+/// polygons and strips are triangulated. Throws InputError naming the file
+/// when it is missing, of another kind, or holds no triangles.
+TriSurface read_surface_file(const std::filesystem::path& file);
+
+/// Length of one file unit in mm for "mm", "cm", "m", "um"; InputError otherwise.
+double unit_length_in_mm(const std::string& unit);
+
+struct SurfaceCheckOptions {
+  std::string units = "mm";           // units of the file's coordinates
+  bool repair = true;                  // false: every defect is an error
+  int expected_open_ends = 2;          // open tube ends (proximal and distal cuts); 0 for a closed surface
+  double merge_tolerance = 1e-6;       // duplicate points closer than this × bounding-box diagonal are merged
+  double small_piece_fraction = 0.01;  // repair drops pieces with less than this fraction of the area
+  double small_hole_fraction = 0.5;    // repair fills holes whose perimeter is below this × the smaller end's
+  double min_size = 1.0, max_size = 500.0;  // mm, plausible bounding-box diagonal of a coronary segment or tree
+  bool check_self_intersections = true;
+};
+
+/// What the checks found and repaired (each count is also a summary QoI).
+struct SurfaceReport {
+  int merged_points = 0;
+  int degenerate_triangles = 0;
+  int duplicate_triangles = 0;
+  int pieces_dropped = 0;
+  int orientation_flips = 0;   // triangles turned to agree with their neighbours
+  bool normals_inverted = false;  // all turned outward
+  int holes_filled = 0;
+  int open_ends = 0;
+  std::vector<std::string> notes;  // human-readable, one per repair
+};
+
+/// Checks and repairs `s` (coordinates in options.units; returned in mm).
+/// Errors (InputError, message starting with `what`): unreadable units,
+/// non-manifold edges, self-intersections, several large pieces, more open
+/// boundaries than expected that are not small holes, fewer open ends than
+/// expected, and — with repair off — any defect that repair would fix.
+TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& options, const std::string& what,
+                            SurfaceReport& report);
+
+/// Pairs of triangles that intersect other than along shared edges/vertices
+/// (CGAL Polygon Mesh Processing); at most `limit` pairs.
+std::vector<std::pair<int, int>> self_intersections(const TriSurface& s, std::size_t limit = 20);
+
+}  // namespace stentsim::segmentation

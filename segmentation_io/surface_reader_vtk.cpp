@@ -1,0 +1,84 @@
+// VTK adapter: reading surfaces in the formats segmentation tools export.
+#include <fmt/format.h>
+#include <vtkAlgorithm.h>
+#include <vtkCellArray.h>
+#include <vtkExecutive.h>
+#include <vtkNew.h>
+#include <vtkOBJReader.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataReader.h>
+#include <vtkSTLReader.h>
+#include <vtkSmartPointer.h>
+#include <vtkTriangleFilter.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <algorithm>
+#include <cctype>
+
+#include "common/error.hpp"
+#include "segmentation_io/surface_input.hpp"
+
+namespace stentsim::segmentation {
+
+double unit_length_in_mm(const std::string& u) {
+  if (u == "mm") return 1.0;
+  if (u == "cm") return 10.0;
+  if (u == "m") return 1000.0;
+  if (u == "um") return 1e-3;
+  throw InputError(fmt::format("unknown length unit '{}'; expected mm, cm, m or um", u));
+}
+
+TriSurface read_surface_file(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: surface file not found", file.string()));
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  vtkSmartPointer<vtkAlgorithm> reader;
+  if (ext == ".vtp") {
+    auto r = vtkSmartPointer<vtkXMLPolyDataReader>::New();
+    if (!r->CanReadFile(file.c_str()))
+      throw InputError(fmt::format("{}: not a VTK XML PolyData (.vtp) file", file.string()));
+    r->SetFileName(file.c_str());
+    reader = r;
+  } else if (ext == ".vtk") {
+    auto r = vtkSmartPointer<vtkPolyDataReader>::New();
+    r->SetFileName(file.c_str());
+    if (!r->IsFilePolyData())
+      throw InputError(fmt::format("{}: not a legacy VTK file with POLYDATA (an unstructured grid or image is not a surface)",
+                                   file.string()));
+    reader = r;
+  } else if (ext == ".stl") {
+    auto r = vtkSmartPointer<vtkSTLReader>::New();
+    r->SetFileName(file.c_str());
+    r->MergingOn();  // STL repeats each vertex per facet
+    reader = r;
+  } else if (ext == ".obj") {
+    auto r = vtkSmartPointer<vtkOBJReader>::New();
+    r->SetFileName(file.c_str());
+    reader = r;
+  } else {
+    throw InputError(fmt::format("{}: unknown surface format '{}'; expected .vtp, .vtk, .stl or .obj", file.string(), ext));
+  }
+  vtkNew<vtkTriangleFilter> tri;
+  tri->SetInputConnection(reader->GetOutputPort());
+  tri->PassLinesOff();
+  tri->PassVertsOff();
+  tri->Update();
+  vtkPolyData* pd = tri->GetOutput();
+  if (!pd || pd->GetNumberOfPolys() == 0)
+    throw InputError(fmt::format("{}: no triangles could be read (damaged or empty {} file?)", file.string(), ext));
+  TriSurface s;
+  s.points.resize(std::size_t(pd->GetNumberOfPoints()));
+  for (vtkIdType i = 0; i < pd->GetNumberOfPoints(); ++i) pd->GetPoint(i, s.points[std::size_t(i)].data());
+  vtkCellArray* polys = pd->GetPolys();
+  vtkNew<vtkIdList> ids;
+  polys->InitTraversal();
+  while (polys->GetNextCell(ids)) {
+    if (ids->GetNumberOfIds() != 3) continue;
+    s.triangles.push_back({int(ids->GetId(0)), int(ids->GetId(1)), int(ids->GetId(2))});
+  }
+  for (const auto& p : s.points)
+    if (!p.allFinite()) throw InputError(fmt::format("{}: a point coordinate is not a finite number", file.string()));
+  return s;
+}
+
+}  // namespace stentsim::segmentation

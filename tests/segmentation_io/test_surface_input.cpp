@@ -1,0 +1,310 @@
+// Surface input: each reader on fixtures the test writes itself, unit sanity,
+// and every check's repair or error message.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "common/error.hpp"
+#include "segmentation_io/centerline.hpp"
+#include "segmentation_io/phantom.hpp"
+#include "segmentation_io/segmentation_stage.hpp"
+#include "segmentation_io/surface_distance.hpp"
+#include "segmentation_io/surface_input.hpp"
+
+using namespace stentsim;
+using namespace stentsim::segmentation;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A small healthy tube (24 around, 10 mm): fast fixtures.
+TriSurface small_tube() {
+  PhantomSpec s = phantom_preset("straight-healthy", 1);
+  s.length = 10;
+  s.circumferential_points = 24;
+  return surface_from_mesh(build_phantom(s).lumen, "tube");
+}
+
+fs::path temp_dir(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("stentsim_test_surface_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write_stl_ascii(const fs::path& f, const TriSurface& s) {
+  std::ofstream o(f);
+  o << "solid test\n";
+  for (const auto& t : s.triangles) {
+    Eigen::Vector3d n = (s.points[t[1]] - s.points[t[0]]).cross(s.points[t[2]] - s.points[t[0]]).normalized();
+    o << "facet normal " << n.x() << " " << n.y() << " " << n.z() << "\n outer loop\n";
+    for (int v : t) o << "  vertex " << s.points[v].x() << " " << s.points[v].y() << " " << s.points[v].z() << "\n";
+    o << " endloop\nendfacet\n";
+  }
+  o << "endsolid test\n";
+}
+
+void write_stl_binary(const fs::path& f, const TriSurface& s) {
+  std::ofstream o(f, std::ios::binary);
+  char header[80] = {};
+  std::strncpy(header, "binary stl written by the stentsim test", 79);
+  o.write(header, 80);
+  std::uint32_t n = std::uint32_t(s.triangles.size());
+  o.write(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& t : s.triangles) {
+    float v[12] = {};
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) v[3 + 3 * k + c] = float(s.points[t[k]][c]);
+    o.write(reinterpret_cast<const char*>(v), 48);
+    std::uint16_t attr = 0;
+    o.write(reinterpret_cast<const char*>(&attr), 2);
+  }
+}
+
+void write_obj(const fs::path& f, const TriSurface& s) {
+  std::ofstream o(f);
+  o.precision(17);
+  for (const auto& p : s.points) o << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+  for (const auto& t : s.triangles) o << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+}
+
+void write_legacy_vtk(const fs::path& f, const TriSurface& s) {
+  std::ofstream o(f);
+  o.precision(17);
+  o << "# vtk DataFile Version 3.0\ntube\nASCII\nDATASET POLYDATA\nPOINTS " << s.points.size() << " double\n";
+  for (const auto& p : s.points) o << p.x() << " " << p.y() << " " << p.z() << "\n";
+  o << "POLYGONS " << s.triangles.size() << " " << 4 * s.triangles.size() << "\n";
+  for (const auto& t : s.triangles) o << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+#define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+}  // namespace
+
+TEST(SurfaceReaders, EveryFormatGivesTheSameSurface) {
+  TriSurface ref = small_tube();
+  fs::path d = temp_dir("readers");
+  write_vtp((d / "t.vtp").string(), mesh_from_surface(ref));
+  write_legacy_vtk(d / "t.vtk", ref);
+  write_stl_ascii(d / "t_ascii.stl", ref);
+  write_stl_binary(d / "t_binary.stl", ref);
+  write_obj(d / "t.obj", ref);
+  for (const char* f : {"t.vtp", "t.vtk", "t_ascii.stl", "t_binary.stl", "t.obj"}) {
+    TriSurface s = read_surface_file(d / f);
+    EXPECT_EQ(s.num_triangles(), ref.num_triangles()) << f;
+    EXPECT_EQ(s.points.size(), ref.points.size()) << f;  // STL: merged back to shared vertices
+    EXPECT_NEAR(surface_area(s), surface_area(ref), 1e-5 * surface_area(ref)) << f;
+    SurfaceReport rep;
+    TriSurface c = check_and_repair(s, {}, f, rep);
+    EXPECT_EQ(rep.open_ends, 2) << f;
+    EXPECT_TRUE(rep.notes.empty()) << f << ": " << (rep.notes.empty() ? "" : rep.notes[0]);
+  }
+  fs::remove_all(d);
+}
+
+TEST(SurfaceReaders, ClearErrors) {
+  fs::path d = temp_dir("reader_errors");
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(d / "missing.stl"); }), "not found");
+  std::ofstream(d / "x.ply") << "ply\n";
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(d / "x.ply"); }), "unknown surface format");
+  std::ofstream(d / "junk.vtp") << "this is not xml";
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(d / "junk.vtp"); }), "junk.vtp");
+  std::ofstream(d / "grid.vtk") << "# vtk DataFile Version 3.0\ng\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 0 double\n";
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(d / "grid.vtk"); }), "POLYDATA");
+  fs::remove_all(d);
+}
+
+TEST(SurfaceChecks, UnitsThatSayMetresAreReported) {
+  TriSurface t = small_tube();
+  for (auto& p : t.points) p *= 1e-3;  // the same tube written in metres
+  SurfaceReport rep;
+  EXPECT_CONTAINS(error_of([&] { check_and_repair(t, {}, "lumen.stl", rep); }), "looks like it is in metres");
+  SurfaceCheckOptions o;
+  o.units = "m";
+  TriSurface ok = check_and_repair(t, o, "lumen.stl", rep);
+  EXPECT_NEAR(bounding_box_diagonal(ok), bounding_box_diagonal(small_tube()), 1e-9);
+}
+
+TEST(SurfaceChecks, DuplicatePointsAreMerged) {
+  TriSurface t = small_tube();
+  // Give triangle 5 its own copies of its vertices (as an STL would).
+  for (int& v : t.triangles[5]) {
+    t.points.push_back(t.points[v]);
+    v = int(t.points.size()) - 1;
+  }
+  SurfaceReport rep;
+  TriSurface r = check_and_repair(t, {}, "lumen", rep);
+  EXPECT_EQ(rep.merged_points, 3);
+  EXPECT_EQ(r.points.size(), small_tube().points.size());
+  SurfaceCheckOptions strict;
+  strict.repair = false;
+  EXPECT_CONTAINS(error_of([&] { check_and_repair(t, strict, "lumen", rep); }), "duplicate points");
+}
+
+TEST(SurfaceChecks, DegenerateAndDuplicateTrianglesAreRemoved) {
+  TriSurface t = small_tube();
+  t.triangles.push_back({3, 3, 4});
+  t.triangles.push_back(t.triangles[10]);
+  SurfaceReport rep;
+  TriSurface r = check_and_repair(t, {}, "lumen", rep);
+  EXPECT_EQ(rep.degenerate_triangles, 1);
+  EXPECT_EQ(rep.duplicate_triangles, 1);
+  EXPECT_EQ(r.num_triangles(), small_tube().num_triangles());
+  SurfaceCheckOptions strict;
+  strict.repair = false;
+  EXPECT_CONTAINS(error_of([&] { check_and_repair(t, strict, "lumen", rep); }), "degenerate");
+}
+
+TEST(SurfaceChecks, NonManifoldEdgeIsAnError) {
+  TriSurface t = small_tube();
+  auto e = t.triangles[400];  // strip 8: all its edges are inner edges
+  t.points.push_back(Eigen::Vector3d(5, 5, 5));
+  t.triangles.push_back({e[0], e[1], int(t.points.size()) - 1});  // a fin on an inner edge
+  SurfaceReport rep;
+  std::string msg = error_of([&] { check_and_repair(t, {}, "lumen.stl", rep); });
+  EXPECT_CONTAINS(msg, "lumen.stl");
+  EXPECT_CONTAINS(msg, "non-manifold");
+}
+
+TEST(SurfaceChecks, SmallHoleIsFilledLargeOneIsAnError) {
+  TriSurface t = small_tube();
+  TriSurface small = t;
+  small.triangles.erase(small.triangles.begin() + 200, small.triangles.begin() + 202);
+  SurfaceReport rep;
+  TriSurface r = check_and_repair(small, {}, "lumen", rep);
+  EXPECT_EQ(rep.holes_filled, 1);
+  EXPECT_EQ(boundary_loops(r).size(), 2u);
+  // A window of two rings: a hole that is not small.
+  TriSurface big = t;
+  const int N = 24;
+  std::vector<std::array<int, 3>> keep;
+  for (std::size_t i = 0; i < big.triangles.size(); ++i) {
+    std::size_t strip = i / (2 * N), j = (i % (2 * N)) / 2;
+    if ((strip == 20 || strip == 21) && j < 8) continue;  // an 8 × 2 window
+    keep.push_back(big.triangles[i]);
+  }
+  big.triangles = keep;
+  std::string msg = error_of([&] { check_and_repair(big, {}, "lumen", rep); });
+  EXPECT_CONTAINS(msg, "open boundaries");
+}
+
+TEST(SurfaceChecks, DisconnectedPieces) {
+  TriSurface t = small_tube();
+  TriSurface tiny = small_tube();
+  // A tiny speck far away: dropped.
+  TriSurface with_speck = t;
+  int base = int(with_speck.points.size());
+  with_speck.points.push_back({20, 0, 0});
+  with_speck.points.push_back({20.01, 0, 0});
+  with_speck.points.push_back({20, 0.01, 0});
+  with_speck.triangles.push_back({base, base + 1, base + 2});
+  SurfaceReport rep;
+  TriSurface r = check_and_repair(with_speck, {}, "lumen", rep);
+  EXPECT_EQ(rep.pieces_dropped, 1);
+  EXPECT_EQ(r.num_triangles(), t.num_triangles());
+  // A second full tube beside it: an error listing the pieces.
+  TriSurface two = t;
+  base = int(two.points.size());
+  for (auto p : tiny.points) two.points.push_back(p + Eigen::Vector3d(5, 0, 0));
+  for (auto tr : tiny.triangles) two.triangles.push_back({tr[0] + base, tr[1] + base, tr[2] + base});
+  EXPECT_CONTAINS(error_of([&] { check_and_repair(two, {}, "lumen", rep); }), "2 disconnected pieces");
+}
+
+TEST(SurfaceChecks, InvertedAndInconsistentNormalsAreTurned) {
+  TriSurface t = small_tube();
+  for (auto& tr : t.triangles) std::swap(tr[1], tr[2]);
+  SurfaceReport rep;
+  TriSurface r = check_and_repair(t, {}, "lumen", rep);
+  EXPECT_TRUE(rep.normals_inverted);
+  EXPECT_GT(signed_volume(capped(r, boundary_loops(r))), 0);
+  TriSurface mixed = small_tube();
+  for (int i : {7, 100, 333}) std::swap(mixed.triangles[i][1], mixed.triangles[i][2]);
+  SurfaceReport rep2;
+  TriSurface r2 = check_and_repair(mixed, {}, "lumen", rep2);
+  EXPECT_EQ(rep2.orientation_flips, 3);
+  EXPECT_FALSE(rep2.normals_inverted);
+  EXPECT_NEAR(signed_volume(capped(r2, boundary_loops(r2))), signed_volume(capped(small_tube(), boundary_loops(small_tube()))), 1e-9);
+}
+
+TEST(SurfaceChecks, SelfIntersectionIsAnError) {
+  TriSurface t = small_tube();
+  // Push one wall vertex through the opposite wall.
+  const int N = 24, ring = 20;
+  t.points[ring * N] = t.points[ring * N + N / 2] * 1.8;
+  t.points[ring * N].z() = t.points[ring * N + N / 2].z();
+  SurfaceReport rep;
+  std::string msg = error_of([&] { check_and_repair(t, {}, "lumen.vtp", rep); });
+  EXPECT_CONTAINS(msg, "intersects itself");
+  EXPECT_FALSE(self_intersections(small_tube()).size());
+}
+
+TEST(SurfaceChecks, ClosedSurfaceIsNotALumen) {
+  TriSurface t = small_tube();
+  TriSurface closed = capped(t, boundary_loops(t));
+  SurfaceReport rep;
+  EXPECT_CONTAINS(error_of([&] { check_and_repair(closed, {}, "tree.stl", rep); }), "0 open ends but 2 were expected");
+  SurfaceCheckOptions o;
+  o.expected_open_ends = 0;
+  EXPECT_NO_THROW(check_and_repair(closed, o, "tree.stl", rep));
+}
+
+TEST(SegmentationStage, SurfaceWithWallAndSynthesizedWallAndPhantom) {
+  fs::path d = temp_dir("stage");
+  PhantomGeometry g = build_phantom(phantom_preset("case2-rca", 1));
+  write_stl_binary(d / "lumen.stl", surface_from_mesh(g.lumen, "l"));
+  write_obj(d / "wall.obj", surface_from_mesh(g.wall, "w"));
+  std::ofstream(d / "case.yaml") << "input:\n  surface:\n    lumen: lumen.stl\n    wall: wall.obj\n";
+  auto cfg = ConfigMap::load(d / "case.yaml");
+  auto input = cfg.map("input");
+  SegmentationInput in = parse_segmentation_input(input);
+  ASSERT_FALSE(in.is_phantom());
+  Summary s;
+  run_segmentation_stage(in, d / "out_lumen.vtp", d / "out_wall.vtp", s);
+  EXPECT_EQ(read_vtp((d / "out_lumen.vtp").string()).num_cells(), g.lumen.num_cells());
+  EXPECT_EQ(std::get<std::string>(s.qois().at("wall_source").value), "file");
+
+  // Lumen only: the wall is synthesized around it and encloses it.
+  SegmentationInput only;
+  SurfaceInput si;
+  si.lumen = d / "lumen.stl";
+  si.synthesis.wall_thickness = 0.7;
+  only.source = si;
+  Summary s2;
+  run_segmentation_stage(only, d / "l2.vtp", d / "w2.vtp", s2);
+  TriSurface wall = surface_from_mesh(read_vtp((d / "w2.vtp").string()), "w2");
+  TriSurface lumen = surface_from_mesh(read_vtp((d / "l2.vtp").string()), "l2");
+  EXPECT_EQ(boundary_loops(wall).size(), 2u);
+  SurfaceDistance to_wall(wall);
+  auto inside = inside_closed_surface(capped(wall, boundary_loops(wall)), lumen.points);
+  std::size_t out = std::count(inside.begin(), inside.end(), false);
+  EXPECT_LT(out, lumen.points.size() / 50);  // only points on the end planes may touch
+  double thinnest = 1e9;
+  for (std::size_t i = 0; i < lumen.points.size(); i += 13) thinnest = std::min(thinnest, to_wall.distance(lumen.points[i]));
+  EXPECT_GT(thinnest, 0.3);
+
+  // Phantom input with the true centerline.
+  auto pc = ConfigMap::from_string("input:\n  phantom:\n    preset: tortuous\n    seed: 2\n", (d / "p.yaml").string());
+  auto pin = pc.map("input");
+  SegmentationInput ph = parse_segmentation_input(pin);
+  Summary s3;
+  run_segmentation_stage(ph, d / "pl.vtp", d / "pw.vtp", s3, d / "pc.vtp");
+  EXPECT_TRUE(fs::exists(d / "pc.vtp"));
+  // Both or neither: an error naming the section.
+  auto both = ConfigMap::from_string("input:\n  phantom: {preset: tortuous}\n  surface: {lumen: x.stl}\n", "c.yaml");
+  auto bin = both.map("input");
+  EXPECT_CONTAINS(error_of([&] { parse_segmentation_input(bin); }), "exactly one of");
+  fs::remove_all(d);
+}
