@@ -1,0 +1,274 @@
+#include "solver/app/solve.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "common/error.hpp"
+#include "common/log.hpp"
+#include "common/summary.hpp"
+#include "solver/io/results_writer.hpp"
+#include "solver/io/scene.hpp"
+#include "solver/io/solid_output.hpp"
+#include "solver/terms/follower_pressure.hpp"
+#include "solver/terms/robin_springs.hpp"
+
+namespace stentsim::solver {
+namespace {
+
+bool is_volume(CellType t) { return t == CellType::hexahedron || t == CellType::tetra || t == CellType::quadratic_tetra; }
+
+std::vector<std::array<Vec3, 3>> cell_frames(const BodyDesc& b, const std::filesystem::path& scene) {
+  std::vector<std::array<Vec3, 3>> frames;
+  const MeshData& m = b.mesh;
+  if (b.frames.kind == FrameSource::Kind::none) return frames;
+  frames.resize(m.num_cells());
+  if (b.frames.kind == FrameSource::Kind::cylindrical) {
+    for (std::size_t c = 0; c < m.num_cells(); ++c) {
+      Vec3 x = Vec3::Zero();
+      const auto conn = m.cell(c);
+      for (auto n : conn) x += m.points[static_cast<std::size_t>(n)];
+      x /= static_cast<double>(conn.size());
+      const Vec3 d = x - b.frames.origin;
+      Vec3 er = d - d.dot(b.frames.axis) * b.frames.axis;
+      if (er.norm() < 1e-12) throw InputError(fmt::format("{}: body '{}': cell {} lies on the fiber frame axis", scene.string(), b.name, c));
+      er.normalize();
+      frames[c] = {er, b.frames.axis.cross(er), b.frames.axis};
+    }
+    return frames;
+  }
+  const MeshData f = read_vtu(b.frames.file.string());
+  if (f.num_cells() != m.num_cells())
+    throw InputError(fmt::format("{}: {} cells, but body '{}' has {}", b.frames.file.string(), f.num_cells(), b.name, m.num_cells()));
+  const std::array<std::string, 3> names{b.frames.radial, b.frames.circumferential, b.frames.longitudinal};
+  for (int k = 0; k < 3; ++k) {
+    auto it = f.cell_data.find(names[static_cast<std::size_t>(k)]);
+    if (it == f.cell_data.end() || it->second.components != 3)
+      throw InputError(fmt::format("{}: expected a 3-component cell array '{}'", b.frames.file.string(), names[static_cast<std::size_t>(k)]));
+    for (std::size_t c = 0; c < m.num_cells(); ++c)
+      frames[c][static_cast<std::size_t>(k)] = Vec3(it->second.at(c, 0), it->second.at(c, 1), it->second.at(c, 2));
+  }
+  return frames;
+}
+
+struct Built {
+  Model model;
+  std::map<std::string, SolidBody*> bodies;
+  std::vector<std::pair<std::string, FollowerPressure*>> pressures;
+  std::vector<std::string> notes;
+};
+
+std::unique_ptr<Built> build(const SceneDesc& scene) {
+  auto out = std::make_unique<Built>();
+  Model& model = out->model;
+  const std::string file = scene.file.string();
+  for (const auto& b : scene.bodies) {
+    SolidBodySpec spec;
+    spec.name = b.name;
+    spec.mesh = b.mesh;
+    std::map<int, int> index;
+    for (const auto& [tag, mat] : b.materials) {
+      index[tag] = static_cast<int>(spec.materials.size());
+      spec.materials.push_back(mat);
+      out->notes.push_back(fmt::format("body {} tag {}: {}", b.name, tag, mat.describe()));
+    }
+    spec.cell_material.assign(spec.mesh.num_cells(), -1);
+    const DataArray* tags = b.tag_array.empty() ? nullptr : &spec.mesh.cell_data.at(b.tag_array);
+    std::size_t solids = 0;
+    for (std::size_t c = 0; c < spec.mesh.num_cells(); ++c) {
+      if (!is_volume(spec.mesh.cell_types[c])) continue;
+      ++solids;
+      if (!tags) {
+        spec.cell_material[c] = 0;
+        continue;
+      }
+      const int tag = static_cast<int>(std::lround(tags->at(c)));
+      auto it = index.find(tag);
+      if (it == index.end())
+        throw InputError(fmt::format("{}: body '{}': cell {} has {} = {} but no material is given for that tag", file, b.name, c,
+                                     b.tag_array, tag));
+      spec.cell_material[c] = it->second;
+    }
+    if (solids == 0) throw InputError(fmt::format("{}: body '{}': the mesh ({}) has no hex8/tet4/tet10 cells", file, b.name, b.mesh_source));
+    spec.cell_frames = cell_frames(b, scene.file);
+    const GlobalDof first = model.dofs.allocate(b.name, 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
+    try {
+      out->bodies[b.name] = &model.add_term<SolidBody>(std::move(spec), first);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", file, e.what()));
+    }
+    log::info("body '{}': {} nodes, {} solid cells ({})", b.name, b.mesh.points.size(), solids, b.mesh_source);
+  }
+  model.size_constraints();
+  std::map<GlobalDof, std::string> framed, globally_fixed;  // node first DOF -> condition name
+  for (const auto& c : scene.conditions) {
+    SolidBody& body = *out->bodies.at(c.body);
+    const LoadCurve curve = c.curve.empty() ? LoadCurve() : scene.curves.at(c.curve);
+    if (c.type != ConditionDesc::Type::dirichlet) {
+      std::vector<bool> active(body.mesh().num_cells());
+      for (std::size_t i = 0; i < active.size(); ++i) active[i] = body.cell_material()[i] >= 0;
+      auto faces = select_faces(body.mesh(), fem::boundary_faces(body.mesh(), active), c.where);
+      if (faces.empty())
+        throw InputError(fmt::format("{}: condition '{}': the surface selection ({}) selects no boundary face of body '{}'", file,
+                                     c.name, c.where.describe(), c.body));
+      log::info("condition '{}': {} faces of body '{}'", c.name, faces.size(), c.body);
+      if (c.type == ConditionDesc::Type::pressure)
+        out->pressures.emplace_back(c.name, &model.add_term<FollowerPressure>(c.name, body, std::move(faces), c.value, curve));
+      else
+        model.add_term<RobinSprings>(c.name, body, std::move(faces), c.value);
+      continue;
+    }
+    const auto nodes = select_nodes(body.mesh(), c.where);
+    if (nodes.empty())
+      throw InputError(fmt::format("{}: condition '{}': the node selection ({}) selects no node of body '{}'", file, c.name,
+                                   c.where.describe(), c.body));
+    log::info("condition '{}': {} nodes of body '{}'", c.name, nodes.size(), c.body);
+    for (auto n : nodes) {
+      const GlobalDof d0 = body.dof(n, 0);
+      if (c.radial_only) {
+        if (globally_fixed.count(d0))
+          throw InputError(fmt::format("{}: condition '{}' (radial only) and '{}' (global components) both hold node {} of body '{}'",
+                                       file, c.name, globally_fixed[d0], n, c.body));
+        const Vec3 d = body.mesh().points[n] - c.axis_origin;
+        Vec3 er = d - d.dot(c.axis) * c.axis;
+        if (er.norm() < 1e-12)
+          throw InputError(fmt::format("{}: condition '{}': node {} lies on the axis; its radial direction is undefined", file, c.name, n));
+        er.normalize();
+        Mat3 q;
+        q.col(0) = er;
+        q.col(1) = c.axis.cross(er);
+        q.col(2) = c.axis;
+        model.constraints.set_frame(d0, q);
+        model.constraints.fix(d0 + 1, [](double) { return 0.0; });
+        model.constraints.fix(d0 + 2, [](double) { return 0.0; });
+        framed[d0] = c.name;
+      } else {
+        if (framed.count(d0))
+          throw InputError(fmt::format("{}: condition '{}' (global components) and '{}' (radial only) both hold node {} of body '{}'",
+                                       file, c.name, framed[d0], n, c.body));
+        for (int comp : c.components)
+          model.constraints.fix(d0 + comp, [v = c.value, curve](double t) { return v * curve(t); });
+        globally_fixed[d0] = c.name;
+      }
+    }
+  }
+  return out;
+}
+
+double qoi_value(const QoiDesc& q, const Built& b, const Eigen::VectorXd& u) {
+  const SolidBody& body = *b.bodies.at(q.body);
+  const auto nodes = select_nodes(body.mesh(), q.where);
+  if (nodes.empty()) throw InputError(fmt::format("qoi '{}': the node selection ({}) is empty", q.name, q.where.describe()));
+  double acc = 0.0;
+  for (auto n : nodes) {
+    if (q.type == QoiDesc::Type::mean_radius) {
+      const Vec3 d = body.position(u, n) - q.axis_origin;
+      acc += (d - d.dot(q.axis) * q.axis).norm();
+    } else {
+      acc = std::max(acc, u.segment<3>(body.dof(n, 0)).norm());
+    }
+  }
+  return q.type == QoiDesc::Type::mean_radius ? acc / static_cast<double>(nodes.size()) : acc;
+}
+
+}  // namespace
+
+int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& options) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  if (options.verbose) log::set_level(log::Level::debug);
+  SceneDesc scene = read_scene(scene_yaml);
+  if (options.linear_solver) scene.linear.type = *options.linear_solver;
+  const std::filesystem::path out_dir = options.output_dir.empty() ? scene_yaml.parent_path() : options.output_dir;
+  auto built = build(scene);
+  Model& model = built->model;
+  log::info("scene {}: {} DOFs, {} fixed, {} terms", scene_yaml.string(), model.dofs.size(), model.constraints.num_fixed(),
+            model.terms.size());
+
+  std::unique_ptr<LinearSolver> linear;
+  try {
+    linear = make_linear_solver(scene.linear);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: solver.linear.type: {}", scene_yaml.string(), e.what()));
+  }
+  {
+    std::vector<std::pair<GlobalDof, Vec3>> nodes;
+    for (const auto& [name, body] : built->bodies)
+      for (std::size_t i = 0; i < body->num_nodes(); ++i) nodes.emplace_back(body->dof(i, 0), body->mesh().points[i]);
+    linear->set_near_null_space(model.rigid_body_modes(nodes));
+  }
+  log::info("linear solver: {}", linear->describe());
+
+  ResultsWriter writer(out_dir);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(model.dofs.size());
+  auto frame = [&](double t) {
+    std::vector<std::pair<std::string, MeshData>> meshes;
+    for (const auto& [name, body] : built->bodies) meshes.emplace_back(name, solid_output(*body, u));
+    writer.write_frame(writer.frames(), t, meshes);
+  };
+  frame(scene.stepping.t_start);
+  std::vector<std::string> columns{"step", "time", "dt", "load_factor", "newton_iterations", "linear_iterations", "step_cuts",
+                                   "wall_time_s", "assembly_s", "linear_solve_s"};
+  for (const auto& [name, p] : built->pressures) columns.push_back("pressure_" + name);
+  writer.history_header(columns);
+
+  Summary summary;
+  std::map<std::string, double> qoi;
+  long newton_total = 0, linear_total = 0, cuts_total = 0;
+  int steps = 0;
+  double t_last = scene.stepping.t_start;
+  const LoadCurve* lf = scene.load_factor_curve.empty() ? nullptr : &scene.curves.at(scene.load_factor_curve);
+  auto on_step = [&](const StepRecord& r) {
+    ++steps;
+    t_last = r.time;
+    newton_total += r.newton_iterations;
+    linear_total += r.linear_iterations;
+    cuts_total += r.cuts;
+    std::vector<double> row{static_cast<double>(r.step), r.time, r.dt, lf ? (*lf)(r.time) : r.time,
+                            static_cast<double>(r.newton_iterations), static_cast<double>(r.linear_iterations),
+                            static_cast<double>(r.cuts), r.wall_seconds, r.assembly_seconds, r.linear_seconds};
+    for (const auto& [name, p] : built->pressures) row.push_back(p->pressure(r.time));
+    writer.history_row(row);
+    const double tol = 1e-9 * std::max(1.0, std::abs(scene.stepping.t_end));
+    bool at_stop = std::abs(r.time - scene.stepping.t_end) < tol;
+    for (double s : scene.stepping.stops) at_stop = at_stop || std::abs(r.time - s) < tol;
+    if (r.step % scene.output_every == 0 || at_stop) frame(r.time);
+    for (const auto& q : scene.qois)
+      if (std::abs(r.time - q.time) < tol) qoi[q.name] = qoi_value(q, *built, u);
+  };
+  GlobalSystem system(model.constraints);
+  int status = 0;
+  std::string failure;
+  try {
+    run_load_steps(model, system, *linear, u, scene.stepping, scene.newton, on_step);
+  } catch (const ComputeError& e) {
+    failure = e.what();
+    status = 2;
+    log::error("{}", failure);
+    if (std::abs(writer.last_time() - t_last) > 1e-12) frame(t_last);  // the last converged state
+    log::error("the last converged state (t = {:.6g}) is in {}", t_last, (out_dir / "results.pvd").string());
+  }
+  for (const auto& q : scene.qois) {
+    if (qoi.count(q.name)) summary.set(q.name, qoi[q.name], q.type == QoiDesc::Type::mean_radius ? "mm" : "mm");
+  }
+  summary.set_text("status", status == 0 ? "completed" : "failed");
+  if (!failure.empty()) summary.note("failure", failure);
+  summary.set("steps", static_cast<double>(steps));
+  summary.set("newton_iterations", static_cast<double>(newton_total));
+  summary.set("linear_iterations", static_cast<double>(linear_total));
+  summary.set("step_cuts", static_cast<double>(cuts_total));
+  summary.set("dofs", static_cast<double>(model.dofs.size()));
+  summary.set("final_time", t_last, "s");
+  summary.note("scene", scene_yaml.string());
+  summary.note("linear_solver", linear->describe());
+  for (std::size_t i = 0; i < built->notes.size(); ++i) summary.note(fmt::format("material_{}", i), built->notes[i]);
+  summary.set_run(std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), peak_memory_mb_self());
+  summary.write(out_dir / "summary.yaml");
+  log::info("solve {}: {} steps, {} Newton iterations; results in {}", status == 0 ? "completed" : "FAILED", steps, newton_total,
+            out_dir.string());
+  return status;
+}
+
+}  // namespace stentsim::solver

@@ -1,0 +1,38 @@
+#include "solver/io/results_writer.hpp"
+
+#include <fmt/format.h>
+
+#include "common/files.hpp"
+
+namespace stentsim::solver {
+
+ResultsWriter::ResultsWriter(std::filesystem::path out_dir) : dir_(std::move(out_dir)) {
+  std::filesystem::create_directories(dir_ / "results");
+}
+
+void ResultsWriter::write_frame(int frame, double time, const std::vector<std::pair<std::string, MeshData>>& bodies) {
+  int part = 0;
+  for (const auto& [name, mesh] : bodies) {
+    const std::string rel = fmt::format("results/{}_{:05d}.vtu", name, frame);
+    write_vtu((dir_ / rel).string(), mesh);
+    pvd_body_ += fmt::format("    <DataSet timestep=\"{:.10g}\" group=\"\" part=\"{}\" name=\"{}\" file=\"{}\"/>\n", time, part++, name, rel);
+  }
+  ++frames_;
+  last_time_ = time;
+  files::write_atomic(dir_ / "results.pvd", "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n" +
+                                                pvd_body_ + "  </Collection>\n</VTKFile>\n");
+}
+
+void ResultsWriter::history_header(const std::vector<std::string>& columns) {
+  history_ = fmt::format("{}\n", fmt::join(columns, ","));
+  files::write_atomic(dir_ / "history.csv", history_);
+}
+
+void ResultsWriter::history_row(const std::vector<double>& values) {
+  std::vector<std::string> cells;
+  for (double v : values) cells.push_back(fmt::format("{:.10g}", v));
+  history_ += fmt::format("{}\n", fmt::join(cells, ","));
+  files::write_atomic(dir_ / "history.csv", history_);
+}
+
+}  // namespace stentsim::solver

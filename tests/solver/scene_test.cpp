@@ -1,0 +1,101 @@
+// The solve stage from a scene file: the tube example runs, writes the PVD
+// (first frame = initial state), VTUs with the stress fields, history.csv and
+// summary.yaml with inner_radius_at_pmax matching the semi-analytic
+// reference; bad scenes give InputError naming file and key.
+#include <gtest/gtest.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "common/mesh_data.hpp"
+#include "common/summary.hpp"
+#include "solver/app/solve.hpp"
+#include "solver/materials/coupled_neo_hooke.hpp"
+#include "tests/solver/tube_reference.hpp"
+
+namespace stentsim::solver {
+namespace {
+
+const std::filesystem::path kExample = std::filesystem::path(STENTSIM_SOURCE_DIR) / "examples/tube_inflation.yaml";
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("stentsim_solver_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+TEST(SolverScene, TubeExampleMatchesReference) {
+  const auto out = fresh_dir("tube");
+  SolveOptions opt;
+  opt.output_dir = out;
+  ASSERT_EQ(solve_scene(kExample, opt), 0);
+  const Summary s = Summary::read(out / "summary.yaml");
+  ASSERT_TRUE(s.qois().count("inner_radius_at_pmax"));
+  const double r = std::get<double>(s.qois().at("inner_radius_at_pmax").value);
+  const auto nh = CoupledNeoHooke::from_young_poisson(1.0, 0.45);
+  const double r_ref = test::TubeReference{nh.c, nh.beta, 0.8, 1.4}.inner_radius(0.12);
+  std::printf("scene: r_i(p_max) = %.6f, reference %.6f, error %.3f %% of u_r\n", r, r_ref, 100 * std::abs(r - r_ref) / (r_ref - 0.8));
+  EXPECT_LT(std::abs(r - r_ref), 0.01 * (r_ref - 0.8));
+  // PVD: the first frame is the initial state at t = 0, the last at t = 1.
+  const std::string pvd = files::read_text(out / "results.pvd");
+  EXPECT_NE(pvd.find("timestep=\"0\""), std::string::npos);
+  EXPECT_NE(pvd.find("timestep=\"1\""), std::string::npos);
+  const MeshData first = read_vtu((out / "results/tube_00000.vtu").string());
+  for (const char* a : {"CauchyStress", "MaxPrincipalStress", "MaxPrincipalDirection", "VonMisesStress", "GreenLagrangeStrain", "MaterialIndex"})
+    EXPECT_TRUE(first.cell_data.count(a)) << a;
+  EXPECT_TRUE(first.point_data.count("Displacement"));
+  // history.csv: header + one row per step (8 steps of 0.125 at most).
+  std::ifstream h(out / "history.csv");
+  std::string line;
+  int rows = -1;
+  while (std::getline(h, line)) ++rows;
+  EXPECT_GE(rows, 4);
+  EXPECT_LE(rows, 8);
+  // Hoop stress at the inner wall is the largest principal stress and positive.
+  int last = 0;
+  while (std::filesystem::exists(out / fmt::format("results/tube_{:05d}.vtu", last + 1))) ++last;
+  const MeshData end = read_vtu((out / fmt::format("results/tube_{:05d}.vtu", last)).string());
+  double smax = 0;
+  for (double v : end.cell_data.at("MaxPrincipalStress").values) smax = std::max(smax, v);
+  EXPECT_GT(smax, 0.12);
+  std::filesystem::remove_all(out);
+}
+
+TEST(SolverScene, BadInputNamesFileAndKey) {
+  const auto dir = fresh_dir("bad");
+  std::string text = files::read_text(kExample);
+  auto expect_error = [&](const std::string& from, const std::string& to, const std::string& needle) {
+    std::string t = text;
+    const auto at = t.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+    files::write_atomic(dir / "scene.yaml", t);
+    try {
+      SolveOptions o;
+      o.output_dir = dir;
+      solve_scene(dir / "scene.yaml", o);
+      ADD_FAILURE() << "no error for " << to;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("scene.yaml"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+    }
+  };
+  expect_error("nu: 0.45", "nu: 0.5", "nu");
+  expect_error("value: 0.12 MPa", "value: 0.12 mm", "value");
+  expect_error("components: y", "components: q", "components");
+  expect_error("curve: ramp", "curve: rampp", "curve");
+  expect_error("radius: 0.8 mm}}\n    value", "radius: 0.7 mm}}\n    value", "selects no boundary face");
+  expect_error("type: direct", "type: cholesky", "type");
+  expect_error("every: 1", "evry: 1", "evry");
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace stentsim::solver
