@@ -32,6 +32,8 @@ class DenseAssembler : public Assembler {
 struct TestSystem {
   std::vector<Term*> terms;
   Eigen::VectorXd u;
+  /// DOFs held at their current value in u (non-homogeneous Dirichlet).
+  std::vector<GlobalDof> fixed;
   explicit TestSystem(GlobalDof n) : u(Eigen::VectorXd::Zero(n)) {}
 
   DenseAssembler assemble(double time) const {
@@ -50,6 +52,12 @@ struct TestSystem {
   int solve(double time, double tol, int max_iterations = 40) {
     for (int it = 1; it <= max_iterations; ++it) {
       DenseAssembler a = assemble(time);
+      for (GlobalDof d : fixed) {
+        a.K.row(d).setZero();
+        a.K.col(d).setZero();
+        a.K(d, d) = 1.0;
+        a.R[d] = 0.0;
+      }
       const Eigen::VectorXd du = a.K.partialPivLu().solve(-a.R);
       if (!du.allFinite()) throw std::runtime_error("test Newton: non-finite increment");
       apply(du);
