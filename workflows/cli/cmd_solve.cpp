@@ -1,0 +1,31 @@
+// `stentsim solve SCENE.yaml`: the finite-element solve of a scene file, on
+// its own (the solve stage of a case calls the same function).
+#include "solver/app/solve.hpp"
+#include "workflows/cli/commands.hpp"
+
+namespace stentsim::cli {
+
+void register_solve(CLI::App& app) {
+  struct Args {
+    std::string scene, out, linear;
+    bool verbose = false;
+  };
+  auto a = std::make_shared<Args>();
+  auto* sub = app.add_subcommand("solve", "Solve a scene file (bodies, materials, loads, solver settings)");
+  sub->add_option("scene", a->scene, "Scene file (YAML)")->required();
+  sub->add_option("--out", a->out, "Output folder (default: beside the scene file)");
+  sub->add_option("--linear-solver", a->linear, "Override the scene's linear solver")
+      ->check(CLI::IsMember({"direct", "gmres_ilu", "gmres_amg", "eigen_lu"}));
+  sub->add_flag("--verbose,-v", a->verbose, "Log every Newton iteration");
+  on(sub, [a] {
+    solver::SolveOptions o;
+    o.output_dir = a->out;
+    if (!a->linear.empty()) o.linear_solver = a->linear;
+    o.verbose = a->verbose;
+    // solve_scene returns non-zero when the computation could not finish
+    // (last converged state written); the CLI's code for that is 1.
+    return solver::solve_scene(a->scene, o) == 0 ? 0 : 1;
+  });
+}
+
+}  // namespace stentsim::cli
