@@ -1,0 +1,57 @@
+#include "solver/beams/beam_output.hpp"
+
+#include "common/error.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace stentsim::solver::beams {
+
+MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int samples_per_element) {
+  if (samples_per_element < 1) throw InputError("beam output: samples_per_element must be >= 1");
+  const BeamSection& sec = beam.body().section;
+  const double R = sec.radius > 0 ? sec.radius : std::sqrt(sec.area / std::numbers::pi);
+  const double A = sec.area, I = sec.bending_inertia;
+  MeshData m;
+  auto arr = [&](const char* name, int comps) -> DataArray& {
+    DataArray& a = m.point_data[name];
+    a.components = comps;
+    return a;
+  };
+  DataArray &radius = arr("Radius", 1), &d1 = arr("TriadD1", 3), &d2 = arr("TriadD2", 3), &d3 = arr("TriadD3", 3);
+  DataArray &axial = arr("AxialForce", 1), &shear = arr("ShearForce", 2), &torsion = arr("TorsionalMoment", 1);
+  DataArray &bending = arr("BendingMoment", 1), &stress = arr("OuterFibreStress", 1), &disp = arr("Displacement", 3);
+  DataArray& element_id = m.cell_data["ElementId"];
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(u.size());
+  for (std::size_t e = 0; e < beam.body().elements.size(); ++e) {
+    std::vector<std::int64_t> ids;
+    for (int k = 0; k <= samples_per_element; ++k) {
+      const double xi = -1.0 + 2.0 * k / samples_per_element;
+      const SectionState s = beam.sample(u, e, xi);
+      const Eigen::Vector3d r0 = beam.sample(zero, e, xi).position;  // reference centerline
+      ids.push_back(static_cast<std::int64_t>(m.points.size()));
+      m.points.push_back(s.position);
+      radius.values.push_back(R);
+      for (int c = 0; c < 3; ++c) {
+        d1.values.push_back(s.triad(c, 0));
+        d2.values.push_back(s.triad(c, 1));
+        d3.values.push_back(s.triad(c, 2));
+        disp.values.push_back(s.position[c] - r0[c]);
+      }
+      const double Mb = std::hypot(s.M[1], s.M[2]);
+      axial.values.push_back(s.F[0]);
+      shear.values.push_back(s.F[1]);
+      shear.values.push_back(s.F[2]);
+      torsion.values.push_back(s.M[0]);
+      bending.values.push_back(Mb);
+      stress.values.push_back((A > 0 ? std::abs(s.F[0]) / A : 0.0) + (I > 0 ? Mb * R / I : 0.0));
+    }
+    m.add_cell(CellType::polyline, ids);
+    element_id.values.push_back(static_cast<double>(e));
+  }
+  m.field_text["units"] = "mm, N, MPa";
+  m.field_text["beam_resultants"] = "material frame: F = C_F Gamma, M = C_M Omega (Simo-Reissner)";
+  return m;
+}
+
+}  // namespace stentsim::solver::beams

@@ -1,0 +1,25 @@
+#pragma once
+// Beam results for the VTU/PVD output (issue 8): the centerline sampled finer
+// than the nodes (ParaView then draws the curved Hermite shape), one
+// polyline per element, with point arrays
+//   Radius            section radius (ParaView's Tube filter: "Vary radius by scalar")
+//   TriadD1..D3       the current section triad
+//   AxialForce        N = F₁                     [N]
+//   ShearForce        (F₂, F₃)                   [N]
+//   TorsionalMoment   M₁                         [N·mm]
+//   BendingMoment     ‖M_b‖ = √(M₂² + M₃²)       [N·mm]
+//   OuterFibreStress  |N|/A + ‖M_b‖ R / I        [MPa]
+//   Displacement      r − r₀                     [mm]
+// and cell data ElementId. Section resultants are the material (convected)
+// ones, F = C_F Γ, M = C_M Ω, components in the section triad.
+#include "common/mesh_data.hpp"
+#include "solver/beams/beam_term.hpp"
+
+#include <Eigen/Core>
+
+namespace stentsim::solver::beams {
+
+/// `samples_per_element` ≥ 1 segments per element (points per element: +1).
+MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int samples_per_element = 8);
+
+}  // namespace stentsim::solver::beams
