@@ -134,6 +134,7 @@ void element_system(const ElementReference& ref, const BeamSection& sec, const s
   constexpr int NH = 3 * NT;
   constexpr int NX = 3 * NC;
   using J = Jet<NH>;
+  using G = Grad<NH>;
   // Perturbed nodal triads exp(S(h_i)) Λ_i, h = 0 as Jet variables.
   std::array<Quat<J>, NT> qq;
   for (int i = 0; i < NT; ++i) {
@@ -141,36 +142,57 @@ void element_system(const ElementReference& ref, const BeamSection& sec, const s
     qq[i] = qmul(qexp_second_order(h), qconst<J>(q[i]));
   }
   const auto field = triad_field<J, NT>(qq);
+  const M3<J> Lr = qmat(field.qr);  // Λ_r
+  std::array<G, 9> Lrg;
+  Eigen::Matrix3d Lrv;
+  for (int k = 0; k < 9; ++k) Lrg[k] = G(Lr[k]), Lrv(k / 3, k % 3) = Lr[k].v;
+  // Nodes with ψ ≡ 0 (the Hermite middle node) are skipped in the sums.
+  constexpr int NPSI = NT == 3 ? 2 : NT;
 
   J energy(0.0);
   Eigen::Matrix<double, NX, 1> gx = Eigen::Matrix<double, NX, 1>::Zero();
   Eigen::Matrix<double, NX, NX> Hxx = Eigen::Matrix<double, NX, NX>::Zero();
   Eigen::Matrix<double, NX, NH> Hxh = Eigen::Matrix<double, NX, NH>::Zero();
   for (const ShapePoint& p : ref.points) {
-    M3<J> L;
-    V3<J> Kap;
-    triad_at<J, NT>(field, p.N, p.dN, L, Kap);
+    // Λ = Λ_r exp(S(ψ)), ψ = Σ N_i ψ_i; Γ = exp(S(ψ))ᵀ Λ_rᵀ r' − Γ₀; K = J_r(ψ) ψ'.
+    V3<J> psi{J(0.0), J(0.0), J(0.0)}, dpsi{J(0.0), J(0.0), J(0.0)};
+    for (int i = 0; i < NPSI; ++i)
+      for (int c = 0; c < 3; ++c) {
+        psi[c] += field.psi[i][c] * p.N[i];
+        dpsi[c] += field.psi[i][c] * p.dN[i];
+      }
+    const J t2 = dot(psi, psi);
+    const J alpha = rotation_coefficient(0, t2), a = rotation_coefficient(1, t2), b = rotation_coefficient(2, t2);
     Eigen::Vector3d dr = Eigen::Vector3d::Zero();
     for (int k = 0; k < NC; ++k) dr += p.dB[k] * x[k];
-    V3<J> Gam, F, M;
+    V3<J> rho;
+    for (int i = 0; i < 3; ++i) rho[i] = Lr[i] * dr[0] + Lr[3 + i] * dr[1] + Lr[6 + i] * dr[2];
+    const V3<J> pr = cross(psi, rho), ppr = cross(psi, pr);
+    const V3<J> pk = cross(psi, dpsi), ppk = cross(psi, pk);
+    V3<J> Gam, Om, F, M;
     for (int i = 0; i < 3; ++i) {
-      Gam[i] = L[i] * dr[0] + L[3 + i] * dr[1] + L[6 + i] * dr[2] - p.Gamma0[i];  // (Λᵀ r')_i − Γ₀
-      F[i] = sec.CF[i] * Gam[i];
-      M[i] = sec.CM[i] * (Kap[i] - p.Kappa0[i]);
+      Gam[i] = rho[i] - alpha * pr[i] + a * ppr[i] - p.Gamma0[i];
+      Om[i] = dpsi[i] - a * pk[i] + b * ppk[i] - p.Kappa0[i];
+      F[i] = Gam[i] * sec.CF[i];
+      M[i] = Om[i] * sec.CM[i];
     }
-    J pi = 0.5 * (dot(Gam, F) + dot(V3<J>{Kap[0] - p.Kappa0[0], Kap[1] - p.Kappa0[1], Kap[2] - p.Kappa0[2]}, M));
+    J pi = 0.5 * (dot(Gam, F) + dot(Om, M));
     pi *= p.weight_ds;
     energy += pi;
-    // Spatial force n = Λ F, its gradient over h, and Λ C_F Λᵀ.
+    // Spatial force n = Λ_r (F + α ψ×F + a ψ×(ψ×F)) to first order, and Λ C_F Λᵀ.
+    const V3<G> psig{G(psi[0]), G(psi[1]), G(psi[2])}, Fg{G(F[0]), G(F[1]), G(F[2])};
+    const G alg(alpha), ag(a);
+    const V3<G> pF = cross(psig, Fg), ppF = cross(psig, pF);
+    V3<G> w;
+    for (int i = 0; i < 3; ++i) w[i] = Fg[i] + alg * pF[i] + ag * ppF[i];
     Eigen::Vector3d nv;
     Eigen::Matrix<double, 3, NH> ng;
-    Eigen::Matrix3d Lv;
     for (int i = 0; i < 3; ++i) {
-      const J ni = L[3 * i] * F[0] + L[3 * i + 1] * F[1] + L[3 * i + 2] * F[2];
+      const G ni = Lrg[3 * i] * w[0] + Lrg[3 * i + 1] * w[1] + Lrg[3 * i + 2] * w[2];
       nv[i] = ni.v;
       ng.row(i) = ni.g.transpose();
-      for (int j = 0; j < 3; ++j) Lv(i, j) = L[3 * i + j].v;
     }
+    const Eigen::Matrix3d Lv = Lrv * quat_exp(Eigen::Vector3d(psi[0].v, psi[1].v, psi[2].v)).toRotationMatrix();
     const Eigen::Matrix3d C = Lv * sec.CF.asDiagonal() * Lv.transpose();
     for (int k = 0; k < NC; ++k) {
       const double wk = p.weight_ds * p.dB[k];
@@ -185,7 +207,7 @@ void element_system(const ElementReference& ref, const BeamSection& sec, const s
   out.K.template topLeftCorner<NX, NX>() = Hxx;
   out.K.template topRightCorner<NX, NH>() = Hxh;
   out.K.template bottomLeftCorner<NH, NX>() = Hxh.transpose();
-  Eigen::Matrix<double, NH, NH> Khh = energy.H;
+  Eigen::Matrix<double, NH, NH> Khh = energy.hessian();
   for (int i = 0; i < NT; ++i)
     Khh.template block<3, 3>(3 * i, 3 * i) -= 0.5 * skew(energy.g.template segment<3>(3 * i));
   out.K.template bottomRightCorner<NH, NH>() = Khh;

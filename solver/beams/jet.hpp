@@ -20,11 +20,18 @@ struct Jet {
   using Vec = Eigen::Matrix<double, N, 1>;
   using Mat = Eigen::Matrix<double, N, N>;
   double v = 0.0;
-  Vec g = Vec::Zero();
-  Mat H = Mat::Zero();
+  Vec g{Vec::Zero()};
+  Mat H{Mat::Zero()};
 
   Jet() = default;
   Jet(double c) : v(c) {}  // NOLINT: implicit constants are the point
+  /// The full Hessian. Only the upper triangle of H is computed (it is
+  /// symmetric; this halves the work of the products); the lower stays zero.
+  Mat hessian() const {
+    Mat full = H;
+    full.template triangularView<Eigen::StrictlyLower>() = H.transpose().template triangularView<Eigen::StrictlyLower>();
+    return full;
+  }
   static Jet variable(double value, int i) {
     Jet j(value);
     j.g[i] = 1.0;
@@ -38,6 +45,35 @@ struct Jet {
 inline double value(double x) { return x; }
 template <int N>
 double value(const Jet<N>& x) { return x.v; }
+
+/// First-order part of a Jet (value and gradient), for quantities whose
+/// Hessian is not needed.
+template <int N>
+struct Grad {
+  double v = 0.0;
+  Eigen::Matrix<double, N, 1> g{Eigen::Matrix<double, N, 1>::Zero()};
+  Grad() = default;
+  Grad(double c) : v(c) {}  // NOLINT
+  Grad(const Jet<N>& j) : v(j.v), g(j.g) {}  // NOLINT
+};
+template <int N>
+Grad<N> operator*(const Grad<N>& a, const Grad<N>& b) {
+  Grad<N> r(a.v * b.v);
+  r.g = a.v * b.g + b.v * a.g;
+  return r;
+}
+template <int N>
+Grad<N> operator+(Grad<N> a, const Grad<N>& b) {
+  a.v += b.v;
+  a.g += b.g;
+  return a;
+}
+template <int N>
+Grad<N> operator-(Grad<N> a, const Grad<N>& b) {
+  a.v -= b.v;
+  a.g -= b.g;
+  return a;
+}
 
 template <int N>
 Jet<N> operator-(const Jet<N>& a) {
@@ -63,10 +99,15 @@ template <int N>
 Jet<N> operator*(double b, Jet<N> a) { return a *= b; }
 template <int N>
 Jet<N> operator*(const Jet<N>& a, const Jet<N>& b) {
+  // One fused pass over the Hessian (the outer products as Eigen
+  // expressions would go through temporaries; this is the hot spot).
   Jet<N> r;
   r.v = a.v * b.v;
-  r.g = a.v * b.g + b.v * a.g;
-  r.H = a.v * b.H + b.v * a.H + a.g * b.g.transpose() + b.g * a.g.transpose();
+  for (int i = 0; i < N; ++i) r.g[i] = a.v * b.g[i] + b.v * a.g[i];
+  for (int j = 0; j < N; ++j) {
+    const double agj = a.g[j], bgj = b.g[j];
+    for (int i = 0; i <= j; ++i) r.H(i, j) = a.v * b.H(i, j) + b.v * a.H(i, j) + a.g[i] * bgj + b.g[i] * agj;
+  }
   return r;
 }
 /// f(a) with f' = d1 and f'' = d2 at a.v (chain rule to second order).
@@ -74,8 +115,11 @@ template <int N>
 Jet<N> chain(const Jet<N>& a, double f, double d1, double d2) {
   Jet<N> r;
   r.v = f;
-  r.g = d1 * a.g;
-  r.H = d1 * a.H + d2 * (a.g * a.g.transpose());
+  for (int i = 0; i < N; ++i) r.g[i] = d1 * a.g[i];
+  for (int j = 0; j < N; ++j) {
+    const double c = d2 * a.g[j];
+    for (int i = 0; i <= j; ++i) r.H(i, j) = d1 * a.H(i, j) + c * a.g[i];
+  }
   return r;
 }
 template <int N>

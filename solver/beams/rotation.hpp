@@ -135,6 +135,53 @@ V3<S> right_jacobian_times(const V3<S>& psi, const V3<S>& v) {
   return {v[0] - a * pv[0] + b * ppv[0], v[1] - a * pv[1] + b * ppv[1], v[2] - a * pv[2] + b * ppv[2]};
 }
 
+/// The SO(3) coefficient functions as functions of t2 = θ², with their first
+/// and second t2-derivatives (for Jet chain rules without 0/0):
+///   kind 0: α = sin θ/θ,  kind 1: a = (1 − cos θ)/θ²,  kind 2: b = (θ − sin θ)/θ³.
+/// exp(S(ψ)) v = v + α ψ×v + a ψ×(ψ×v);  J_r(ψ) v = v − a ψ×v + b ψ×(ψ×v).
+struct CoefficientValue {
+  double f, d1, d2;
+};
+inline CoefficientValue rotation_coefficient(int kind, double t2) {
+  if (t2 < 0.25) {
+    // Σ_k (−1)^k t2^k / (2k + 1 + kind)!, 12 terms (remainder < 1e-30)
+    double c[12];
+    double fact = 1.0;
+    for (int m = 2; m <= 1 + kind; ++m) fact *= m;  // (1 + kind)!
+    for (int k = 0; k < 12; ++k) {
+      if (k > 0) fact *= (2.0 * k + kind) * (2.0 * k + 1 + kind);
+      c[k] = (k % 2 ? -1.0 : 1.0) / fact;
+    }
+    double f = 0, d1 = 0, d2 = 0;
+    for (int k = 11; k >= 0; --k) f = f * t2 + c[k];
+    for (int k = 11; k >= 1; --k) d1 = d1 * t2 + k * c[k];
+    for (int k = 11; k >= 2; --k) d2 = d2 * t2 + k * (k - 1.0) * c[k];
+    return {f, d1, d2};
+  }
+  const double t = std::sqrt(t2), s = std::sin(t), c = std::cos(t);
+  const double t3 = t2 * t, t4 = t2 * t2, t5 = t4 * t;
+  double f, f1, f2;  // f(θ), f'(θ), f''(θ)
+  if (kind == 0) {
+    f = s / t;
+    f1 = (t * c - s) / t2;
+    f2 = -s / t - 2 * c / t2 + 2 * s / t3;
+  } else if (kind == 1) {
+    f = (1 - c) / t2;
+    f1 = s / t2 - 2 * (1 - c) / t3;
+    f2 = c / t2 - 4 * s / t3 + 6 * (1 - c) / t4;
+  } else {
+    f = (t - s) / t3;
+    f1 = (1 - c) / t3 - 3 * (t - s) / t4;
+    f2 = s / t3 - 6 * (1 - c) / t4 + 12 * (t - s) / t5;
+  }
+  return {f, f1 / (2 * t), (f2 - f1 / t) / (4 * t2)};
+}
+template <int N>
+Jet<N> rotation_coefficient(int kind, const Jet<N>& t2) {
+  const CoefficientValue c = rotation_coefficient(kind, t2.v);
+  return chain(t2, c.f, c.d1, c.d2);
+}
+
 // ---- double helpers with Eigen types -------------------------------------
 
 inline Eigen::Matrix3d skew(const Eigen::Vector3d& v) {

@@ -111,7 +111,10 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     const bool du_ok = du_norm <= settings.increment_tolerance * std::max(u.norm(), 1e-12) || r_norm == 0.0;
     log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}", it, r_norm,
                scale, du_norm, best_alpha, ls.iterations);
-    if (r_ok && du_ok) {
+    // Round-off floor: an increment at machine precision cannot improve the state
+    // further (tiny loads on stiff models leave |R| just above an absolute tolerance).
+    const bool stagnated = du_norm <= 1e-13 * std::max(u.norm(), 1e-300) && it > 1;
+    if ((r_ok && du_ok) || stagnated) {
       res.converged = true;
       return res;
     }

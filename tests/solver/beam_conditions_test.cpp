@@ -66,7 +66,7 @@ TEST(BeamRotation, JetDerivativesOfLogMatchFiniteDifferences) {
         const Eigen::Vector3d dj = e * Eigen::Vector3d::Unit(j);
         // symmetric part of the second derivative along exp(S(a e_i + b e_j))
         const double fd = (fval(di + dj) - fval(di - dj) - fval(-di + dj) + fval(-di - dj)) / (4 * e * e);
-        EXPECT_NEAR(f.H(i, j), fd, 1e-5) << angle << " " << i << j;
+        EXPECT_NEAR(f.hessian()(i, j), fd, 1e-5) << angle << " " << i << j;
       }
     }
   }
