@@ -129,7 +129,7 @@ ElementReference make_element_reference(BeamInterpolation kind, const std::array
     r.length = (x0[1] - x0[0]).norm();
     if (!(r.length > 0.0)) throw InputError("beam element: end nodes coincide (zero length)");
   }
-  const int ngp = gauss_points > 0 ? gauss_points : (kind == BeamInterpolation::hermite3 ? 4 : 1);
+  const int ngp = gauss_points > 0 ? gauss_points : (kind == BeamInterpolation::hermite3 ? 3 : 1);
   std::vector<double> xs, ws;
   gauss_legendre(ngp, xs, ws);
   for (int i = 0; i < ngp; ++i) {

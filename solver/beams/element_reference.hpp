@@ -59,8 +59,11 @@ struct ElementReference {
 
 /// Builds the reference data. Hermite: x0 = {X_a, T_a, X_b, T_b} with unit
 /// reference tangents, q0 = {Λ_a, Λ_b, Λ_mid}; Lagrange: x0 = {X_a, X_b},
-/// q0 = {Λ_a, Λ_b}. `gauss_points` = 0 picks the default (Hermite: 4,
-/// Lagrange: 1).
+/// q0 = {Λ_a, Λ_b}. `gauss_points` = 0 picks the default: Hermite 3 (the
+/// lowest stable Gauss rule: 3 × 6 strains ≥ 21 − 6 rigid modes; 2 points
+/// leave spurious zero-energy modes; 3 points integrate the linearized energy
+/// of a straight element exactly and gave the smallest roll-up errors of 3, 4,
+/// 5 points), Lagrange 1 (reduced, as 4C's Line2).
 ElementReference make_element_reference(BeamInterpolation kind, const std::array<Eigen::Vector3d, 4>& x0,
                                         const std::array<Eigen::Quaterniond, 3>& q0, int gauss_points = 0);
 

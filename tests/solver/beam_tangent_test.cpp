@@ -155,3 +155,30 @@ TEST(BeamTangent, DofCounts) {
   number_beam_dofs(def, 10, &n);
   EXPECT_EQ(n, 10 + 4 * 9 + 3 * 3);
 }
+
+TEST(BeamTangent, ReferenceStiffnessHasExactlySixRigidModes) {
+  // Stability of the default quadrature: a free element at its (curved)
+  // reference has 6 zero-energy modes (rigid motions) and no spurious ones.
+  for (BeamInterpolation kind : {BeamInterpolation::hermite3, BeamInterpolation::lagrange2}) {
+    for (int gp : {0, 2}) {
+      if (kind == BeamInterpolation::lagrange2 && gp == 2) continue;
+      BeamBodyDefinition def = curve_body(helix(2.0, 1.0), 1.0, 1, test_section(), kind, gp);
+      GlobalDof n = 0;
+      BeamTerm beam("b", def, number_beam_dofs(def, 0, &n));
+      TestSystem sys(n);
+      sys.terms = {&beam};
+      const DenseAssembler a = sys.assemble(0.0);
+      const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a.K).eigenvalues();
+      int zero = 0;
+      for (long i = 0; i < ev.size(); ++i) zero += std::abs(ev[i]) < 1e-9 * ev.maxCoeff();
+      std::printf("%s, %s Gauss points: %d zero-energy modes of %ld\n",
+                  kind == BeamInterpolation::hermite3 ? "hermite" : "lagrange", gp ? "2" : "default", zero, ev.size());
+      if (gp == 0) {
+        EXPECT_EQ(zero, 6);
+        EXPECT_GT(ev.minCoeff(), -1e-9 * ev.maxCoeff());
+      } else {
+        EXPECT_GT(zero, 6);  // the test detects an unstable rule
+      }
+    }
+  }
+}
