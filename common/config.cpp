@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "common/error.hpp"
@@ -24,6 +25,25 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 }
 
 std::string fmt_number(double v) { return fmt::format("{:g}", v); }
+
+/// yaml-cpp keeps the first of two equal map keys and drops the second
+/// silently; a case file must not mean something other than it says.
+void reject_duplicate_keys(const YAML::Node& n, const std::filesystem::path& file, const std::string& path) {
+  if (n.IsMap()) {
+    std::set<std::string> seen;
+    for (const auto& kv : n) {
+      const std::string k = kv.first.Scalar();
+      const std::string kp = path.empty() ? k : path + "." + k;
+      if (!seen.insert(k).second) {
+        const auto m = kv.first.Mark();
+        throw InputError(fmt::format("{}:{}:{}: {}: duplicate key '{}'", file.string(), m.line + 1, m.column + 1, kp, k));
+      }
+      reject_duplicate_keys(kv.second, file, kp);
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) reject_duplicate_keys(n[i], file, fmt::format("{}[{}]", path, i));
+  }
+}
 
 }  // namespace
 
@@ -51,6 +71,7 @@ ConfigMap ConfigMap::load(const std::filesystem::path& file) {
     throw InputError(fmt::format("{}:{}:{}: YAML syntax error: {}", file.string(), e.mark.line + 1, e.mark.column + 1, e.msg));
   }
   if (!root.IsMap()) throw InputError(fmt::format("{}: expected a YAML map at the top level", file.string()));
+  reject_duplicate_keys(root, file, "");
   return ConfigMap(root, std::make_shared<const std::filesystem::path>(file), "");
 }
 
@@ -62,6 +83,7 @@ ConfigMap ConfigMap::from_string(const std::string& text, const std::filesystem:
     throw InputError(fmt::format("{}:{}:{}: YAML syntax error: {}", file.string(), e.mark.line + 1, e.mark.column + 1, e.msg));
   }
   if (!root.IsMap()) throw InputError(fmt::format("{}: expected a YAML map at the top level", file.string()));
+  reject_duplicate_keys(root, file, "");
   return ConfigMap(root, std::make_shared<const std::filesystem::path>(file), "");
 }
 
@@ -178,7 +200,7 @@ std::filesystem::path ConfigMap::path(const std::string& key, std::optional<std:
     p = n.Scalar();
   }
   if (p.is_relative()) p = file_->parent_path() / p;
-  return p.lexically_normal();
+  return std::filesystem::absolute(p).lexically_normal();
 }
 
 std::vector<double> ConfigMap::numbers(const std::string& key, std::size_t count, std::optional<std::vector<double>> def) {

@@ -89,7 +89,7 @@ void write_generic_artery(const GenericArterySpec& s, const std::string& artery_
   for (std::size_t c = 0; c < m.num_cells(); ++c)
     if (m.cell_types[c] == CellType::hexahedron) {
       ++hex;
-      if (m.cell_data.at(tags::kLayer).at(c) == tags::media) ++media;
+      if (static_cast<int>(m.cell_data.at(tags::kLayer).at(c)) == tags::media) ++media;
     }
   summary.set("artery_nodes", static_cast<double>(m.points.size()));
   summary.set("artery_dofs", 3.0 * static_cast<double>(m.points.size()));

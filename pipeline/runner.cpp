@@ -53,6 +53,9 @@ struct Running {
   StageChild child;
   std::chrono::steady_clock::time_point start;
   fs::path temp_dir;
+  // Taken before the stage starts: an input edited while it runs must leave
+  // the stage stale, not be recorded as the content its outputs came from.
+  std::map<std::string, std::string> input_hashes;
 };
 
 std::string join_reasons(const std::vector<std::string>& r) { return fmt::format("{}", fmt::join(r, "; ")); }
@@ -157,25 +160,29 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - r.start).count();
     StageOutcome o = collect_stage(r.child, wstatus, static_cast<double>(ru.ru_maxrss) / 1024.0, dt);
     if (o.ok) {
-      // Rename outputs into place, then record: a crash in between leaves a
-      // manifest whose output hashes differ, so the stage simply runs again.
-      for (const auto& declared : plan_.outputs(r.stage)) {
-        fs::path tmp = r.temp_dir / declared;
-        if (!fs::exists(tmp)) {
+      // All outputs must exist before any is renamed, so a stage that wrote
+      // only some of them never replaces earlier artifacts.
+      for (const auto& declared : plan_.outputs(r.stage))
+        if (!fs::exists(r.temp_dir / declared)) {
           o.ok = false;
           o.message = fmt::format("did not write its declared output {}", declared);
           break;
         }
+    }
+    if (o.ok) {
+      // Rename outputs into place, then record: a crash in between leaves a
+      // manifest whose output hashes differ, so the stage simply runs again.
+      for (const auto& declared : plan_.outputs(r.stage)) {
         fs::path target = plan_.work_dir() / declared;
         fs::create_directories(target.parent_path());
-        files::replace(tmp, target);
+        files::replace(r.temp_dir / declared, target);
       }
     }
     fs::remove_all(r.temp_dir);
     StageRecord rec;
     rec.version = s.version;
     rec.config_hash = files::text_hash(s.config);
-    rec.inputs = hash_inputs(plan_, r.stage);
+    rec.inputs = r.input_hashes;
     rec.finished = utc_now_iso8601();
     rec.duration_s = dt;
     rec.peak_memory_mb = o.peak_memory_mb;
@@ -233,23 +240,38 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       const fs::path temp_dir = plan_.work_dir() / ".tmp" / s.name;
       fs::remove_all(temp_dir);
       fs::create_directories(temp_dir);
+      auto input_hashes = hash_inputs(plan_, i);
       StageChild child = start_stage(s, plan_.work_dir(), temp_dir, plan_.work_dir() / "logs" / (s.name + ".log"));
-      running[child.pid] = Running{i, child, std::chrono::steady_clock::now(), temp_dir};
+      running[child.pid] = Running{i, child, std::chrono::steady_clock::now(), temp_dir, std::move(input_hashes)};
       it = pending.begin();
     }
     if (running.empty()) break;
+    if (g_stop_signal)
+      for (const auto& [p, r] : running) ::kill(-p, SIGTERM);  // the stage's process group
     int wstatus = 0;
     rusage ru{};
     pid_t pid = ::wait4(-1, &wstatus, 0, &ru);
     if (pid < 0) {
       if (errno == EINTR) {
-        if (g_stop_signal)
-          for (const auto& [p, r] : running) ::kill(p, SIGTERM);
-        continue;
+        continue;  // the loop forwards the stop signal
       }
       throw ComputeError(fmt::format("waiting for stages failed: {}", std::strerror(errno)));
     }
-    if (running.count(pid)) finish_child(pid, wstatus, ru);
+    if (!running.count(pid)) continue;
+    const std::string finished_name = stages[running.at(pid).stage].name;
+    try {
+      finish_child(pid, wstatus, ru);
+    } catch (const std::exception& e) {
+      // Recording failed (disk full, rename refused): stop the other stages
+      // before reporting, so nothing writes the case after the lock is gone.
+      for (const auto& [p, r] : running) ::kill(-p, SIGTERM);
+      while (!running.empty()) {
+        pid_t q = ::waitpid(-1, nullptr, 0);
+        if (q > 0) running.erase(q);
+        else if (errno != EINTR) break;
+      }
+      throw ComputeError(fmt::format("stage {}: {}", finished_name, e.what()));
+    }
   }
   if (g_stop_signal) report.interrupted = true;
   std::error_code ec;

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -41,15 +42,23 @@ StageChild start_stage(const Stage& stage, const std::filesystem::path& work_dir
     ::close(fds[0]);
     ::signal(SIGINT, SIG_DFL);
     ::signal(SIGTERM, SIG_DFL);
+    // Its own process group, so the runner can stop the stage and anything it
+    // started (mpirun, gmsh) together; and it dies when the runner is killed,
+    // so no orphan keeps the work-folder lock.
+    ::setpgid(0, 0);
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() == 1) ::_exit(1);
     const auto start = std::chrono::steady_clock::now();
     try {
       log::set_file(log_file);
       log::set_prefix(stage.name);
+      log::debug("---- stage {} started (pid {}) ----", stage.name, ::getpid());
       StageContext ctx(stage, work_dir, temp_dir);
       stage.run(ctx);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       ctx.summary().set_run(wall, peak_memory_mb_self());
       ctx.summary().write(ctx.output(summary_output(stage.name)));
+      log::info("finished in {:.2f} s", wall);
       child_exit(fds[1], 0, "");
     } catch (const std::exception& e) {
       log::error("{}", e.what());
@@ -58,6 +67,7 @@ StageChild start_stage(const Stage& stage, const std::filesystem::path& work_dir
       child_exit(fds[1], 1, "unknown error");
     }
   }
+  ::setpgid(pid, pid);  // also here: no race with a stop signal sent right after fork
   ::close(fds[1]);
   return {pid, fds[0]};
 }

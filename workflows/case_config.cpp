@@ -105,6 +105,13 @@ CaseConfig load_case(const std::filesystem::path& file) {
   const std::string scene = top.choice("scene", {"free-expansion", "generic-artery", "patient"});
   c.scene = scene == "free-expansion" ? Scene::free_expansion : scene == "generic-artery" ? Scene::generic_artery : Scene::patient;
   c.work_dir = top.path("work_dir", std::filesystem::path(file.stem().string() + ".work"));
+  // The work folder holds the manifest, lock and logs: it must not be the
+  // case's own folder or one of its ancestors.
+  const auto up = c.file.parent_path().lexically_relative(c.work_dir);
+  if (up.empty() || up == "." || up.native().rfind("..", 0) != 0)
+    top.fail("work_dir", "must be a folder of its own (e.g. 'case.work'), not the case file's folder or above it");
+  if (std::filesystem::exists(c.work_dir) && !std::filesystem::is_directory(c.work_dir))
+    top.fail("work_dir", "'" + c.work_dir.string() + "' exists and is not a folder");
   c.mesh = parse_mesh(top.map("mesh"), c.generic_artery);
   c.fibers = parse_fibers(top.map("fibers"));
   c.simulation = parse_simulation(top.map("simulation"));

@@ -1,7 +1,7 @@
 #include "workflows/case_sections.hpp"
 
 #include "segmentation_io/centerline.hpp"
-#include "segmentation_io/phantom.hpp"
+#include "segmentation_io/segmentation_stage.hpp"
 
 namespace stentsim::workflows {
 
@@ -14,10 +14,7 @@ void validate_stage_sections(const CaseConfig& c, ConfigMap& top) {
   } else {
     if (!top.has("input")) top.fail("input", "a patient scene needs an input section (e.g. input: {phantom: {preset: case2-rca}})");
     auto input = top.map("input");
-    if (!input.has("phantom")) input.fail("", "expected 'phantom' (surface files, SimVascular and label images are not supported yet)");
-    auto phantom = input.map("phantom");
-    segmentation::parse_phantom(phantom);
-    input.finish();
+    segmentation::parse_segmentation_input(input);
     auto centerline = top.map("centerline");
     segmentation::parse_centerline_options(centerline);
   }

@@ -7,7 +7,7 @@
 #include "fibers/analytic_tube_fibers.hpp"
 #include "meshing/generic_artery.hpp"
 #include "segmentation_io/centerline.hpp"
-#include "segmentation_io/phantom.hpp"
+#include "segmentation_io/segmentation_stage.hpp"
 
 namespace stentsim::workflows {
 namespace {
@@ -52,18 +52,31 @@ Stage tube_fibers_stage(const CaseConfig& c) {
   return s;
 }
 
-Stage phantom_segmentation_stage(const CaseConfig& c) {
+segmentation::SegmentationInput segmentation_input(const CaseConfig& c) {
+  ConfigMap input(c.section("input"), std::make_shared<const std::filesystem::path>(c.file), "input");
+  return segmentation::parse_segmentation_input(input);
+}
+
+Stage segmentation_stage(const CaseConfig& c) {
   Stage s;
   s.name = "segmentation";
-  s.outputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp", "segmentation/centerline_true.vtp"};
+  s.outputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp"};
   s.config = slice(c, {"input"});
   s.version = "1";
-  ConfigMap input(c.section("input"), std::make_shared<const std::filesystem::path>(c.file), "input");
-  auto section = input.map("phantom");
-  const segmentation::PhantomSpec spec = segmentation::parse_phantom(section);
-  s.run = [spec](StageContext& ctx) {
-    segmentation::write_phantom(spec, ctx.output("segmentation/lumen.vtp"), ctx.output("segmentation/wall.vtp"),
-                                ctx.output("segmentation/centerline_true.vtp"), ctx.summary());
+  const auto input = segmentation_input(c);
+  if (input.is_phantom()) {
+    s.outputs.push_back("segmentation/centerline_true.vtp");
+  } else {
+    // The user's files are external inputs: editing one makes the stage stale.
+    const auto& surf = std::get<segmentation::SurfaceInput>(input.source);
+    s.inputs.push_back(surf.lumen.string());
+    if (surf.wall) s.inputs.push_back(surf.wall->string());
+  }
+  s.run = [input](StageContext& ctx) {
+    segmentation::run_segmentation_stage(input, ctx.output("segmentation/lumen.vtp"), ctx.output("segmentation/wall.vtp"),
+                                         ctx.summary(),
+                                         input.is_phantom() ? ctx.output("segmentation/centerline_true.vtp")
+                                                            : std::filesystem::path());
   };
   return s;
 }
@@ -71,16 +84,18 @@ Stage phantom_segmentation_stage(const CaseConfig& c) {
 Stage centerline_stage(const CaseConfig& c) {
   Stage s;
   s.name = "centerline";
-  // The phantom's true centerline is an input too: the stage reports its
-  // accuracy against it (inscribed_radius_error_max, stenosis_site_error).
-  s.inputs = {"segmentation/lumen.vtp", "segmentation/centerline_true.vtp"};
+  s.inputs = {"segmentation/lumen.vtp"};
   s.outputs = {"centerline/centerline.vtp"};
   s.config = slice(c, {"centerline"});
   s.version = "1";
   ConfigMap section(c.section("centerline"), std::make_shared<const std::filesystem::path>(c.file), "centerline");
   segmentation::CenterlineOptions options = segmentation::parse_centerline_options(section);
-  s.run = [options](StageContext& ctx) mutable {
-    options.true_centerline = ctx.input("segmentation/centerline_true.vtp");
+  // A phantom's true centerline is an input too: the stage reports its
+  // accuracy against it (inscribed_radius_error_max, stenosis_site_error).
+  const bool phantom = segmentation_input(c).is_phantom();
+  if (phantom) s.inputs.push_back("segmentation/centerline_true.vtp");
+  s.run = [options, phantom](StageContext& ctx) mutable {
+    if (phantom) options.true_centerline = ctx.input("segmentation/centerline_true.vtp");
     segmentation::run_centerline_stage(options, ctx.input("segmentation/lumen.vtp"),
                                        ctx.output("centerline/centerline.vtp"), ctx.summary());
   };
@@ -105,7 +120,7 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
       stages.push_back(tube_fibers_stage(c));
       break;
     case Scene::patient:
-      stages.push_back(phantom_segmentation_stage(c));
+      stages.push_back(segmentation_stage(c));
       stages.push_back(centerline_stage(c));
       break;
   }

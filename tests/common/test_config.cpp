@@ -60,6 +60,21 @@ TEST(Config, SyntaxErrorNamesTheFile) {
   EXPECT_NE(msg.find("/nonexistent/case.yaml: file not found"), std::string::npos) << msg;
 }
 
+TEST(Config, DuplicateKeysAreErrors) {
+  auto msg = error_of([] { ConfigMap::from_string("scene: patient\nmesh: {size: 1}\nscene: generic-artery\n", "dup.yaml"); });
+  EXPECT_NE(msg.find("dup.yaml:3:1: scene: duplicate key 'scene'"), std::string::npos) << msg;
+  msg = error_of([] { ConfigMap::from_string("cases:\n  - {id: a, x: 1, x: 2}\n", "dup.yaml"); });
+  EXPECT_NE(msg.find("cases[0].x: duplicate key 'x'"), std::string::npos) << msg;
+}
+
+TEST(Config, PathsAreAbsoluteAndRelativeToTheFile) {
+  auto top = ConfigMap::from_string("lumen: lumen.stl\n", "cases/p.yaml");
+  const auto p = top.path("lumen");
+  EXPECT_TRUE(p.is_absolute());
+  EXPECT_EQ(p.filename(), "lumen.stl");
+  EXPECT_EQ(p.parent_path().filename(), "cases");
+}
+
 TEST(Config, CanonicalTextIgnoresKeyOrder) {
   auto a = YAML::Load("{x: 1, y: {b: 2, a: 3}}");
   auto b = YAML::Load("{y: {a: 3, b: 2}, x: 1}");

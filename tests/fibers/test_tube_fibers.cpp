@@ -30,7 +30,7 @@ TEST(TubeFibers, FramesAndFamiliesFollowThePaper) {
     for (auto n : f.cell(c)) x += f.points[static_cast<std::size_t>(n)];
     x /= 8;
     ASSERT_GT(er.dot(Eigen::Vector3d(x.x(), x.y(), 0)), 0);
-    const double phi = f.cell_data.at(tags::kLayer).at(c) == tags::media ? 0.0 : phi_a;
+    const double phi = static_cast<int>(f.cell_data.at(tags::kLayer).at(c)) == tags::media ? 0.0 : phi_a;
     ASSERT_NEAR(v("Fiber1", c).dot(et), std::cos(phi), 1e-12);
     ASSERT_NEAR(v("Fiber1", c).dot(ez), std::sin(phi), 1e-12);
     ASSERT_NEAR(v("Fiber2", c).dot(ez), -std::sin(phi), 1e-12);

@@ -37,9 +37,9 @@ TEST(GenericArtery, DefaultMeshHasThePaperSizeAndPositiveVolumes) {
       const double v = hex_volume(m, m.cell(c));
       ASSERT_GT(v, 0) << "inverted hex " << c;
       volume += v;
-      if (layer.at(c) == tags::media) media_volume += v;
+      if (static_cast<int>(layer.at(c)) == tags::media) media_volume += v;
       ++hex;
-      EXPECT_EQ(face.at(c), tags::no_face);
+      EXPECT_EQ(static_cast<int>(face.at(c)), tags::no_face);
     } else {
       ASSERT_EQ(m.cell_types[c], CellType::quad);
       ++faces[static_cast<int>(face.at(c))];

@@ -262,12 +262,67 @@ TEST_F(RunnerTest, OnlyNeedsItsInputsToExist) {
   EXPECT_THROW(run(only), InputError);
 }
 
-TEST_F(RunnerTest, ParallelJobsRunIndependentStages) {
+TEST_F(RunnerTest, ParallelJobsRunIndependentStagesAtTheSameTime) {
+  // a and d are independent; each waits for the other at a barrier, so the
+  // run succeeds only if --jobs 2 really runs them concurrently.
+  config["a"] = "p=1 barrier";
+  config["d"] = "s=1 barrier";
   RunOptions o;
   o.jobs = 2;
-  EXPECT_EQ(run(o).exit_code(), 0);
+  EXPECT_EQ(run(o).exit_code(), 0) << last_output;
   for (auto s : {"a", "b", "c", "d"}) EXPECT_EQ(count(s), 1) << s;
-  EXPECT_EQ(files::read_text(work / "c/out.txt"), "patient data\na:p=1\nb:q=1\nc:r=1\n");
+  EXPECT_EQ(files::read_text(work / "c/out.txt"), "patient data\na:p=1 barrier\nb:q=1\nc:r=1\n");
+}
+
+TEST_F(RunnerTest, BarrierFailsWithOneJob) {
+  // The check above can fail: with one job the barrier is never met.
+  config["a"] = "p=1 barrier";
+  config["d"] = "s=1 barrier";
+  fs::create_directories(counters / "barrier");
+  RunOptions o;
+  o.jobs = 1;
+  o.until = "a";
+  EXPECT_EQ(run(o).exit_code(), 1);
+}
+
+TEST_F(RunnerTest, StageThatWritesOnlySomeOutputsReplacesNothing) {
+  auto two_outputs = [&](const std::string& cfg) {
+    auto s = concat_stage("m", {external.string()}, "m/x.txt", cfg, counters);
+    s.outputs.push_back("m/y.txt");
+    auto inner = s.run;
+    s.run = [inner, cfg](StageContext& ctx) {
+      inner(ctx);
+      if (cfg.find("partial") == std::string::npos) files::write_atomic(ctx.output("m/y.txt"), "y\n");
+    };
+    return std::vector<Stage>{s};
+  };
+  {
+    Runner r(Plan(two_outputs("v=1"), work), "test");
+    std::ostringstream out;
+    ASSERT_EQ(r.run({}, out).exit_code(), 0);
+  }
+  const std::string x_before = files::read_text(work / "m/x.txt");
+  Runner r(Plan(two_outputs("v=2 partial"), work), "test");
+  std::ostringstream out;
+  auto rep = r.run({}, out);
+  EXPECT_EQ(rep.exit_code(), 1);
+  EXPECT_NE(rep.first_failure.find("did not write its declared output m/y.txt"), std::string::npos) << rep.first_failure;
+  EXPECT_EQ(files::read_text(work / "m/x.txt"), x_before);  // not replaced by the partial run
+}
+
+TEST_F(RunnerTest, InputEditedWhileTheStageRunsLeavesItStale) {
+  // The recorded input hash is the one taken before the stage started.
+  auto st = stages();
+  auto inner = st[2].run;  // stage a reads `external`
+  const auto ext = external;
+  st[2].run = [inner, ext](StageContext& ctx) {
+    inner(ctx);
+    files::write_atomic(ext, "edited during the run\n");
+  };
+  Runner r(Plan(st, work), "test");
+  std::ostringstream out;
+  ASSERT_EQ(r.run({}, out).exit_code(), 0);
+  EXPECT_EQ(run().ran.front(), "a");  // stale again: its output came from the old content
 }
 
 TEST_F(RunnerTest, StageSummaryRecordsTimeAndMemory) {

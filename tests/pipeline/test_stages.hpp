@@ -36,6 +36,27 @@ inline pipeline::Stage concat_stage(const std::string& name, std::vector<std::st
     std::filesystem::create_directories(counters);
     std::ofstream(counters / name, std::ios::app) << "ran\n";
     if (config.find("sleep") != std::string::npos) std::this_thread::sleep_for(std::chrono::seconds(30));
+    // "barrier": wait (up to 20 s) until every stage named in the counters'
+    // barrier folder has arrived; passes only if the stages run concurrently.
+    if (config.find("barrier") != std::string::npos) {
+      const auto dir = counters / "barrier";
+      std::filesystem::create_directories(dir);
+      std::ofstream(dir / name) << "here\n";
+      for (int i = 0; i < 2000; ++i) {
+        int n = 0;
+        for ([[maybe_unused]] auto& e : std::filesystem::directory_iterator(dir)) ++n;
+        if (n >= 2) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+      int n = 0;
+      for ([[maybe_unused]] auto& e : std::filesystem::directory_iterator(dir)) ++n;
+      if (n < 2) throw InputError("barrier: the other stage never ran at the same time");
+    }
+    if (config.find("partial") != std::string::npos) {
+      // Writes its first output only, then "forgets" the second.
+      files::write_atomic(ctx.output(output), "partial\n");
+      return;
+    }
     if (config.find("crash") != std::string::npos) std::abort();
     if (config.find("fail") != std::string::npos) throw InputError("deliberate failure of " + name);
     std::string text;

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "workflows/case_config.hpp"
@@ -64,11 +66,36 @@ TEST(CaseConfig, BadFilesGiveErrorsThatNameFileLineKeyAndExpectation) {
   EXPECT_NE(msg.find("expected an integer, got 'many'"), std::string::npos) << msg;
   msg = load_error("scene: free-expansion\ninput:\n  phantom: {preset: case2-rca}\n");
   EXPECT_NE(msg.find("has no artery input"), std::string::npos) << msg;
+  msg = load_error("scene: patient\nscene: generic-artery\n");
+  EXPECT_NE(msg.find("duplicate key 'scene'"), std::string::npos) << msg;
   msg = load_error("scene: generic-artery\nmesh:\n  generic: {outer_diameter: 1 mm}\n");
   EXPECT_NE(msg.find("less than outer_diameter"), std::string::npos) << msg;
 }
 
-TEST(CaseConfig, StageNamesFollowTheDesign) {
-  EXPECT_EQ(all_stage_names(), (std::vector<std::string>{"segmentation", "centerline", "placement", "balloon", "stent",
-                                                         "mesh", "fibers", "solve", "report"}));
+TEST(CaseConfig, EveryScenesStagesAreDesignStagesInDesignOrder) {
+  const auto dir = temp_dir() / "names";
+  fs::remove_all(dir);
+  const auto& names = all_stage_names();
+  EXPECT_EQ(names, (std::vector<std::string>{"segmentation", "centerline", "placement", "balloon", "stent", "mesh",
+                                             "fibers", "solve", "report"}));
+  for (const char* scene : {"free-expansion", "generic-artery", "patient"}) {
+    const auto c = load_case(write_example_case(dir, scene));
+    long last = -1;
+    for (const auto& st : stages_for(c)) {
+      const long pos = std::find(names.begin(), names.end(), st.name) - names.begin();
+      ASSERT_LT(pos, static_cast<long>(names.size())) << scene << ": unknown stage " << st.name;
+      EXPECT_GT(pos, last) << scene << ": " << st.name << " out of order";
+      last = pos;
+      if (std::string(scene) != "patient")
+        for (const char* artery_only : {"segmentation", "centerline"}) EXPECT_NE(st.name, artery_only) << scene;
+      if (std::string(scene) == "free-expansion")
+        for (const char* artery_only : {"mesh", "fibers"}) EXPECT_NE(st.name, artery_only) << scene;
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CaseConfig, WorkDirMustBeAFolderOfItsOwn) {
+  auto msg = load_error("scene: patient\ninput: {phantom: {preset: case2-rca}}\nwork_dir: .\n");
+  EXPECT_NE(msg.find("work_dir: must be a folder of its own"), std::string::npos) << msg;
 }

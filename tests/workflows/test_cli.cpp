@@ -80,4 +80,43 @@ TEST_F(Cli, InitRunStatusAndSecondRunSkipsEveryStage) {
   }
 }
 
+TEST_F(Cli, ForceUntilAndOnlyParseInEveryForm) {
+  ASSERT_EQ(sh("init " + dir.string() + " --scene generic-artery").code, 0);
+  const std::string c = (dir / "generic-artery.yaml").string();
+  ASSERT_EQ(sh("run " + c).code, 0);
+  auto ran = [](const Result& r) { return r.out.substr(r.out.rfind('\n', r.out.size() - 2) + 1); };
+  for (const std::string args : {"run " + c + " --force", "run --force " + c}) {
+    auto r = sh(args);
+    ASSERT_EQ(r.code, 0) << args << "\n" << r.out;
+    EXPECT_EQ(ran(r).rfind("2 ran, 0 up to date", 0), 0u) << args << "\n" << r.out;
+  }
+  for (const std::string args : {"run " + c + " --force mesh", "run --force mesh " + c, "run --force=mesh " + c}) {
+    auto r = sh(args);
+    ASSERT_EQ(r.code, 0) << args << "\n" << r.out;
+    EXPECT_EQ(ran(r).rfind("1 ran, 1 up to date", 0), 0u) << args << "\n" << r.out;
+  }
+  auto r = sh("run " + c + " --force nosuchstage");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("no stage named 'nosuchstage'"), std::string::npos) << r.out;
+  r = sh("run " + c + " --until=");
+  EXPECT_EQ(r.code, 2) << r.out;
+  r = sh("run " + c + " --until mesh --only mesh");
+  EXPECT_EQ(r.code, 2) << r.out;
+  r = sh("run " + c + " --dry-run --force");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("run   mesh          forced"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, SolveRunsASceneAndRejectsBadOnes) {
+  const std::string scene = std::string(STENTSIM_TEST_SOURCE_DIR) + "/examples/tube_inflation.yaml";
+  auto r = sh("solve " + scene + " --out " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "results.pvd"));
+  const auto summary = stentsim::files::read_text(dir / "summary.yaml");
+  EXPECT_NE(summary.find("inner_radius_at_pmax"), std::string::npos) << summary;
+  r = sh("solve " + (dir / "missing.yaml").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("missing.yaml"), std::string::npos) << r.out;
+}
+
 }  // namespace

@@ -64,7 +64,7 @@ void register_cohort(CLI::App& app) {
   cohort->require_subcommand(1);
   struct Args {
     std::string file, cases, until, only;
-    std::vector<std::string> force;
+    std::string force;
     bool dry_run = false;
     int workers = 0;
   };
@@ -88,7 +88,7 @@ void register_cohort(CLI::App& app) {
     if (!a->only.empty()) o.run_args.insert(o.run_args.end(), {"--only", a->only});
     if (force->count()) {
       o.run_args.push_back("--force");
-      if (!a->force.empty()) o.run_args.push_back(a->force[0]);
+      if (!a->force.empty()) o.run_args.push_back(a->force);
     }
     if (a->dry_run) o.run_args.push_back("--dry-run");
     const auto rep = workflows::run_cohort(c, o, std::cout);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 
 #include "common/error.hpp"
@@ -18,7 +19,7 @@ namespace {
 struct RunArgs {
   std::string case_file;
   std::string until, only;
-  std::vector<std::string> force;
+  std::string force;  // --force [STAGE]: empty with the flag given = every stage
   bool dry_run = false;
   int jobs = 1;
 };
@@ -28,9 +29,9 @@ pipeline::Runner make_runner(const workflows::CaseConfig& c) {
 }
 
 int run_case(RunArgs& a, bool force_given) {
-  // "--force CASE.yaml" with no stage: CLI11 takes the file as the stage.
-  if (a.case_file.empty() && a.force.size() == 1 && a.force[0].ends_with(".yaml")) {
-    a.case_file = a.force[0];
+  // "--force CASE.yaml" with no stage: the parser gives the file to --force.
+  if (a.case_file.empty() && !a.force.empty() && std::filesystem::is_regular_file(a.force)) {
+    a.case_file = a.force;
     a.force.clear();
   }
   if (a.case_file.empty()) throw InputError("run: the case file is missing (stentsim run CASE.yaml)");
@@ -40,8 +41,9 @@ int run_case(RunArgs& a, bool force_given) {
   pipeline::RunOptions o;
   if (!a.until.empty()) o.until = a.until;
   if (!a.only.empty()) o.only = a.only;
+
   o.force_all = force_given && a.force.empty();
-  o.force.insert(a.force.begin(), a.force.end());
+  if (!a.force.empty()) o.force.insert(a.force);
   o.dry_run = a.dry_run;
   o.jobs = a.jobs;
   std::cout << fmt::format("case {} ({} scene), work folder {}\n", c.name, workflows::to_string(c.scene), c.work_dir.string());
@@ -83,6 +85,8 @@ void register_run(CLI::App& app) {
   run->add_option("--until", args->until, "Run this stage and the stages it needs, then stop");
   run->add_option("--only", args->only, "Run only this stage (its inputs must exist)");
   auto* force = run->add_option("--force", args->force, "Re-run every stage, or only STAGE")->expected(0, 1);
+  run->get_option("--until")->check(CLI::Validator([](std::string& v) { return v.empty() ? "a stage name is required" : ""; }, "STAGE"));
+  run->get_option("--only")->check(CLI::Validator([](std::string& v) { return v.empty() ? "a stage name is required" : ""; }, "STAGE"));
   run->add_flag("--dry-run", args->dry_run, "Print the plan and why each stage would run; run nothing");
   run->add_option("--jobs,-j", args->jobs, "Independent stages to run at once")->check(CLI::Range(1, 64));
   on(run, [args, force] { return run_case(*args, force->count() > 0); });

@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   }
   try {
     return stentsim::cli::dispatch(app);
+  } catch (const stentsim::Interrupted&) {
+    std::fprintf(stderr, "interrupted\n");
+    return 130;
   } catch (const stentsim::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

@@ -7,11 +7,13 @@ void register_run(CLI::App& app);
 void register_init(CLI::App& app);
 void register_cohort(CLI::App& app);
 void register_solve(CLI::App& app);
+void register_segmentation(CLI::App& app);
 
 void register_all(CLI::App& app) {
   register_init(app);
   register_run(app);
   register_cohort(app);
+  register_segmentation(app);
   register_solve(app);
   register_version(app);
 }

@@ -1,0 +1,52 @@
+// `stentsim phantom` and `stentsim centerline`: the first two stages as tools
+// of their own.
+#include <cstdio>
+
+#include "common/config.hpp"
+#include "common/summary.hpp"
+#include "segmentation_io/centerline.hpp"
+#include "segmentation_io/phantom.hpp"
+#include "workflows/cli/commands.hpp"
+
+namespace stentsim::cli {
+
+void register_segmentation(CLI::App& app) {
+  struct PhantomArgs {
+    std::string preset, out;
+    unsigned seed = 1;
+  };
+  auto p = std::make_shared<PhantomArgs>();
+  auto* phantom = app.add_subcommand("phantom", "Write a synthetic patient: lumen.vtp, wall.vtp, centerline_true.vtp");
+  phantom->add_option("--preset", p->preset, "Preset")->required()->check(CLI::IsMember(segmentation::phantom_preset_names()));
+  phantom->add_option("--seed", p->seed, "Seed (deterministic output per seed)");
+  phantom->add_option("--out", p->out, "Output folder")->required();
+  on(phantom, [p] {
+    Summary summary;
+    segmentation::write_phantom(segmentation::phantom_preset(p->preset, p->seed), p->out, summary);
+    summary.write(std::filesystem::path(p->out) / "summary.yaml");
+    std::printf("wrote %s/{lumen,wall,centerline_true}.vtp\n", p->out.c_str());
+    return 0;
+  });
+
+  struct CenterlineArgs {
+    std::string lumen, out, truth;
+    double spacing = 0.1;
+  };
+  auto c = std::make_shared<CenterlineArgs>();
+  auto* cl = app.add_subcommand("centerline", "Compute the lumen centerline (VMTK arrays) of a lumen surface");
+  cl->add_option("--lumen", c->lumen, "Lumen surface (VTP with triangles, open ends)")->required();
+  cl->add_option("--out", c->out, "Output centerline.vtp")->required();
+  cl->add_option("--spacing", c->spacing, "Resampling spacing in mm")->check(CLI::PositiveNumber);
+  cl->add_option("--true-centerline", c->truth, "A phantom's centerline_true.vtp to report accuracy against");
+  on(cl, [c] {
+    segmentation::CenterlineOptions o;
+    o.spacing = c->spacing;
+    if (!c->truth.empty()) o.true_centerline = c->truth;
+    Summary summary;
+    segmentation::run_centerline_stage(o, c->lumen, c->out, summary);
+    summary.write(std::filesystem::path(c->out).parent_path() / "summary.yaml");
+    return 0;
+  });
+}
+
+}  // namespace stentsim::cli
