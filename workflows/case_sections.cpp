@@ -1,6 +1,7 @@
 #include "workflows/case_sections.hpp"
 
 #include "segmentation_io/centerline.hpp"
+#include "device_gen/stages.hpp"
 #include "segmentation_io/segmentation_stage.hpp"
 
 namespace stentsim::workflows {
@@ -18,9 +19,18 @@ void validate_stage_sections(const CaseConfig& c, ConfigMap& top) {
     auto centerline = top.map("centerline");
     segmentation::parse_centerline_options(centerline);
   }
-  // Device sections are validated by the device stages' parsers once they are wired.
   auto device = top.map("device");
-  (void)device;
+  auto balloon = device.map("balloon");
+  device_gen::parse_balloon_design(balloon);
+  auto stent = device.map("stent");
+  device_gen::parse_stent_design(stent);
+  if (c.scene == Scene::patient) {
+    auto placement = device.map("placement");
+    device_gen::parse_placement_params(placement);
+  } else if (device.has("placement")) {
+    device.fail("placement", "only a patient scene places the device along a centerline; remove this section");
+  }
+  device.finish();
 }
 
 }  // namespace stentsim::workflows

@@ -4,6 +4,7 @@
 
 #include "common/config.hpp"
 #include "common/mesh_tags.hpp"
+#include "device_gen/stages.hpp"
 #include "fibers/analytic_tube_fibers.hpp"
 #include "meshing/generic_artery.hpp"
 #include "segmentation_io/centerline.hpp"
@@ -102,6 +103,61 @@ Stage centerline_stage(const CaseConfig& c) {
   return s;
 }
 
+ConfigMap section_map(const CaseConfig& c, const std::string& dotted) {
+  return ConfigMap(c.section(dotted), std::make_shared<const std::filesystem::path>(c.file), dotted);
+}
+
+struct DeviceDesign {
+  device_gen::BalloonDesign balloon;
+  device_gen::StentDesign stent;
+};
+
+DeviceDesign device_design(const CaseConfig& c) {
+  auto b = section_map(c, "device.balloon");
+  auto st = section_map(c, "device.stent");
+  return {device_gen::parse_balloon_design(b), device_gen::parse_stent_design(st)};
+}
+
+Stage placement_stage(const CaseConfig& c) {
+  Stage s;
+  s.name = "placement";
+  s.inputs = {"centerline/centerline.vtp", "segmentation/lumen.vtp"};
+  s.outputs = {"placement/placement.yaml", "placement/balloon_centerline.vtp"};
+  // Placement uses the balloon length and the stent's length and envelope too.
+  s.config = slice(c, {"device"});
+  s.version = "1";
+  auto p = section_map(c, "device.placement");
+  const auto params = device_gen::parse_placement_params(p);
+  const auto d = device_design(c);
+  s.run = [params, d](StageContext& ctx) {
+    device_gen::run_placement_stage(params, ctx.input("centerline/centerline.vtp"), ctx.input("segmentation/lumen.vtp"),
+                                    d.balloon, d.stent, ctx.output("placement/placement.yaml"),
+                                    ctx.output("placement/balloon_centerline.vtp"), ctx.summary());
+  };
+  return s;
+}
+
+/// Balloon or stent: along the placement's balloon centerline in a patient,
+/// straight along +z otherwise (DESIGN.md §3).
+Stage device_stage(const CaseConfig& c, const std::string& name) {
+  Stage s;
+  s.name = name;
+  const bool placed = c.scene == Scene::patient;
+  if (placed) s.inputs = {"placement/placement.yaml"};
+  s.outputs = {name + "/" + name + ".vtu"};
+  s.config = slice(c, {name == "balloon" ? "device.balloon" : "device.stent"});
+  s.version = "1";
+  const auto d = device_design(c);
+  s.run = [d, name, placed](StageContext& ctx) {
+    std::optional<std::filesystem::path> placement;
+    if (placed) placement = ctx.input("placement/placement.yaml");
+    const auto out = ctx.output(name + "/" + name + ".vtu");
+    if (name == "balloon") device_gen::run_balloon_stage(d.balloon, placement, out, ctx.summary());
+    else device_gen::run_stent_stage(d.stent, placement, out, ctx.summary());
+  };
+  return s;
+}
+
 }  // namespace
 
 const std::vector<std::string>& all_stage_names() {
@@ -114,14 +170,21 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
   std::vector<pipeline::Stage> stages;
   switch (c.scene) {
     case Scene::free_expansion:
+      stages.push_back(device_stage(c, "balloon"));
+      stages.push_back(device_stage(c, "stent"));
       break;
     case Scene::generic_artery:
+      stages.push_back(device_stage(c, "balloon"));
+      stages.push_back(device_stage(c, "stent"));
       stages.push_back(generic_mesh_stage(c));
       stages.push_back(tube_fibers_stage(c));
       break;
     case Scene::patient:
       stages.push_back(segmentation_stage(c));
       stages.push_back(centerline_stage(c));
+      stages.push_back(placement_stage(c));
+      stages.push_back(device_stage(c, "balloon"));
+      stages.push_back(device_stage(c, "stent"));
       break;
   }
   return stages;

@@ -11,7 +11,7 @@ std::filesystem::path write_example_case(const std::filesystem::path& dir, const
   const auto& examples = embedded_examples();
   auto it = examples.find(scene + ".yaml");
   if (it == examples.end())
-    throw InputError(fmt::format("init: no example for scene '{}'; scenes: free-expansion, generic-artery, patient", scene));
+    throw InputError(fmt::format("init: no example named '{}'; scenes: free-expansion, generic-artery, patient", scene));
   const auto target = dir / it->first;
   if (std::filesystem::exists(target))
     throw InputError(fmt::format("{}: already exists; init does not overwrite files", target.string()));

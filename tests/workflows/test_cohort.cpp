@@ -68,7 +68,7 @@ TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* id : {"coarse", "fine", "other"}) {
     const auto log = read_text(dir / "cohort.work" / id / "run.log");
-    EXPECT_NE(log.find("0 ran, 2 up to date"), std::string::npos) << log;
+    EXPECT_NE(log.find("0 ran, 4 up to date"), std::string::npos) << log;
   }
   r = sh("cohort status " + f);
   EXPECT_EQ(r.code, 0) << r.out;
@@ -111,6 +111,23 @@ TEST_F(Cohort, BadCohortFilesStopBeforeAnythingRuns) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("nowhere.yaml: file not found"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir / "cohort.work"));
+}
+
+TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
+  const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-example-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  auto r = sh("init " + dir.string() + " --cohort");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string f = (dir / "cohort.yaml").string();
+  // Two of the six cases, up to placement: one fits, one must fail there.
+  r = sh("cohort run " + f + " --cases rca-seed1,severe --until placement");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("severe               failed as expected at placement"), std::string::npos) << r.out;
+  const auto csv = read_text(dir / "cohort.work/cohort_summary.csv");
+  EXPECT_NE(csv.find("\"severe\",\"failed as expected\",\"placement\""), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"rca-seed1\",\"done\""), std::string::npos) << csv;
+  EXPECT_NE(csv.find("placement.placement_min_clearance [mm]"), std::string::npos) << csv;
+  fs::remove_all(dir);
 }
 
 TEST(CohortSlots, NeverOversubscribeCores) {
