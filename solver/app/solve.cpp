@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -10,6 +12,7 @@
 #include "common/error.hpp"
 #include "common/log.hpp"
 #include "common/summary.hpp"
+#include "solver/assembly/parallel.hpp"
 #include "solver/io/results_writer.hpp"
 #include "solver/io/scene.hpp"
 #include "solver/io/solid_output.hpp"
@@ -199,9 +202,16 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
       for (std::size_t i = 0; i < body->num_nodes(); ++i) nodes.emplace_back(body->dof(i, 0), body->mesh().points[i]);
     linear->set_near_null_space(model.rigid_body_modes(nodes));
   }
-  log::info("linear solver: {}", linear->describe());
+  // Ranks: after the linear solver exists (Trilinos initialises MPI when the
+  // CLI has not). Every rank holds u; elements are split; rank 0 writes.
+  model.rank = parallel::rank();
+  model.ranks = parallel::size();
+  const bool writes = model.rank == 0;
+  if (!writes) log::set_level(log::Level::warn);
+  log::info("linear solver: {}; {} MPI rank(s)", linear->describe(), model.ranks);
 
-  ResultsWriter writer(out_dir);
+  ResultsWriter writer(writes ? out_dir : std::filesystem::temp_directory_path() /
+                                              fmt::format("stentsim_rank{}_{}", model.rank, ::getpid()));
   Eigen::VectorXd u = Eigen::VectorXd::Zero(model.dofs.size());
   auto frame = [&](double t) {
     std::vector<std::pair<std::string, MeshData>> meshes;
@@ -265,7 +275,8 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   summary.note("linear_solver", linear->describe());
   for (std::size_t i = 0; i < built->notes.size(); ++i) summary.note(fmt::format("material_{}", i), built->notes[i]);
   summary.set_run(std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), peak_memory_mb_self());
-  summary.write(out_dir / "summary.yaml");
+  if (writes) summary.write(out_dir / "summary.yaml");
+  else std::filesystem::remove_all(std::filesystem::temp_directory_path() / fmt::format("stentsim_rank{}_{}", model.rank, ::getpid()));
   log::info("solve {}: {} steps, {} Newton iterations; results in {}", status == 0 ? "completed" : "FAILED", steps, newton_total,
             out_dir.string());
   return status;

@@ -1,5 +1,7 @@
 #include "solver/assembly/global_system.hpp"
 
+#include "solver/assembly/parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -82,6 +84,10 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
 }
 
 void GlobalSystem::finish() {
+  if (ranks_ > 1) {
+    parallel::sum(residual_);
+    if (with_tangent_) parallel::sum(correction_);
+  }
   if (!with_tangent_) return;
   const GlobalDof n = constraints_.size();
   for (GlobalDof d = 0; d < n; ++d)
@@ -114,7 +120,7 @@ void GlobalSystem::finish() {
     pending_.clear();
   }
   for (GlobalDof d = 0; d < n; ++d)
-    if (constraints_.fixed(d)) matrix_.values[static_cast<std::size_t>(matrix_.find(d, d))] = 1.0;
+    if (constraints_.fixed(d)) matrix_.values[static_cast<std::size_t>(matrix_.find(d, d))] = rank_ == 0 ? 1.0 : 0.0;
 }
 
 double GlobalSystem::free_residual_norm() const {

@@ -27,6 +27,9 @@ class GlobalSystem : public Assembler {
   void add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& residual,
            const Eigen::Ref<const Eigen::MatrixXd>& tangent) override;
   bool wants_tangent() const override { return with_tangent_; }
+  /// This rank among `ranks`: residuals are summed over ranks in finish(),
+  /// the identity on fixed rows comes from rank 0 only.
+  void set_parallel(int rank, int ranks) { rank_ = rank, ranks_ = ranks; }
   /// Merge new couplings into the pattern and put the identity on fixed rows.
   void finish();
 
@@ -46,6 +49,7 @@ class GlobalSystem : public Assembler {
   CsrMatrix matrix_;
   std::vector<std::tuple<GlobalDof, GlobalDof, double>> pending_;  // entries outside the pattern
   bool with_tangent_ = true;
+  int rank_ = 0, ranks_ = 1;
   // scratch for frame rotations (grows, never shrinks: no per-element allocation)
   Eigen::VectorXd r_scratch_;
   Eigen::MatrixXd k_scratch_;

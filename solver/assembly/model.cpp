@@ -1,12 +1,28 @@
 #include "solver/assembly/model.hpp"
 
+#include "solver/assembly/parallel.hpp"
+#include "solver/terms/element_failure.hpp"
+
 namespace stentsim::solver {
 
 void Model::assemble(const Eigen::VectorXd& u, double time, double dt, const Eigen::VectorXd& prescribed,
                      GlobalSystem& system, bool with_tangent) {
   system.begin(prescribed, with_tangent);
+  system.set_parallel(rank, ranks);
   SystemState state{u, time, dt, rank, ranks};
-  for (auto& t : terms) t->assemble(state, system);
+  // A failing element on one rank must fail the assembly on every rank.
+  std::string failure;
+  try {
+    for (auto& t : terms) t->assemble(state, system);
+  } catch (const ElementFailure& e) {
+    failure = e.what();
+  }
+  if (ranks > 1) {
+    const std::string first = parallel::first_message(!failure.empty(), failure);
+    if (!first.empty()) throw ElementFailure(first);
+  } else if (!failure.empty()) {
+    throw ElementFailure(failure);
+  }
   system.finish();
 }
 

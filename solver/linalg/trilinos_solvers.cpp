@@ -13,12 +13,16 @@
 #include <Teuchos_ParameterList.hpp>
 #include <Tpetra_Core.hpp>
 #include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Export.hpp>
 #include <Tpetra_MultiVector.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "solver/linalg/linear_solver.hpp"
 
@@ -59,7 +63,8 @@ class TrilinosSolver : public LinearSolver {
   void set_near_null_space(const Eigen::MatrixXd& modes) override { modes_ = modes; }
 
   std::string describe() const override {
-    if (settings_.type == "direct") return "Amesos2 KLU2 (direct)";
+    if (settings_.type == "direct")
+      return comm_->getSize() > 1 ? "direct: matrix gathered on rank 0, sparse LU" : "Amesos2 KLU2 (direct)";
     std::ostringstream o;
     o << "Belos block GMRES (Krylov space " << settings_.krylov_size << ", tol " << settings_.tolerance << ") + ";
     if (settings_.type == "gmres_ilu") o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
@@ -77,6 +82,14 @@ class TrilinosSolver : public LinearSolver {
     for (LO i = 0; i < static_cast<LO>(map->getNodeNumElements()); ++i) bv->replaceLocalValue(i, 0, b(map->getGlobalElement(i)));
     xv->putScalar(0.0);
 
+    if (settings_.type == "direct" && comm_->getSize() > 1) {
+      // Amesos2 KLU2 on a distributed matrix returned wrong solutions with
+      // Debian's Trilinos 13.2 (caught by test_solver_mpi_two_ranks); gather
+      // the assembled matrix on rank 0 instead, factor it there and broadcast.
+      stats = gathered_direct_solve(mat, map, b, x);
+      stats.setup_seconds += seconds(t0, Clock::now()) - stats.solve_seconds;
+      return stats;
+    }
     if (settings_.type == "direct") {
       auto direct = Amesos2::create<Matrix, MV>("KLU2", mat, xv, bv);
       direct->symbolicFactorization().numericFactorization();
@@ -125,16 +138,18 @@ class TrilinosSolver : public LinearSolver {
 
  private:
   RCP<Matrix> build_matrix(const CsrMatrix& a, const RCP<const Map>& map) const {
-    // Capacity per owned row: this rank's entries, doubled on several ranks for
-    // contributions that arrive from the others.
+    // Capacity per owned row: the sum over ranks of their entries in it (an
+    // upper bound of the union that fillComplete assembles).
     const std::size_t local_rows = map->getNodeNumElements();
     Teuchos::Array<std::size_t> capacity(local_rows, 0);
-    const int ranks = comm_->getSize();
-    for (std::size_t i = 0; i < local_rows; ++i) {
-      const auto g = static_cast<std::size_t>(map->getGlobalElement(static_cast<LO>(i)));
-      const auto count = static_cast<std::size_t>(a.row_ptr[g + 1] - a.row_ptr[g]);
-      capacity[i] = ranks > 1 ? 2 * count + 81 : count;
-    }
+    std::vector<long long> counts(static_cast<std::size_t>(a.rows)), total(static_cast<std::size_t>(a.rows));
+    for (std::int64_t i = 0; i < a.rows; ++i) counts[static_cast<std::size_t>(i)] = a.row_ptr[static_cast<std::size_t>(i) + 1] - a.row_ptr[static_cast<std::size_t>(i)];
+    if (comm_->getSize() > 1)
+      Teuchos::reduceAll<int, long long>(*comm_, Teuchos::REDUCE_SUM, static_cast<int>(a.rows), counts.data(), total.data());
+    else
+      total = counts;
+    for (std::size_t i = 0; i < local_rows; ++i)
+      capacity[i] = static_cast<std::size_t>(std::max(1LL, total[static_cast<std::size_t>(map->getGlobalElement(static_cast<LO>(i)))]));
     RCP<Matrix> m = rcp(new Matrix(map, capacity()));
     Teuchos::Array<GO> cols;
     for (std::int64_t i = 0; i < a.rows; ++i) {
@@ -146,6 +161,42 @@ class TrilinosSolver : public LinearSolver {
     }
     m->fillComplete();
     return m;
+  }
+
+  LinearSolveStats gathered_direct_solve(const RCP<Matrix>& mat, const RCP<const Map>& map, const Eigen::VectorXd& b,
+                                         Eigen::VectorXd& x) const {
+    const GO n = static_cast<GO>(map->getGlobalNumElements());
+    const bool root = comm_->getRank() == 0;
+    RCP<const Map> gmap = rcp(new Map(n, root ? static_cast<std::size_t>(n) : 0, 0, comm_));
+    RCP<Matrix> gathered = rcp(new Matrix(gmap, 0));
+    Tpetra::Export<LO, GO, NO> exporter(map, gmap);
+    gathered->doExport(*mat, exporter, Tpetra::INSERT);
+    gathered->fillComplete(gmap, gmap);
+    LinearSolveStats stats;
+    x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+    if (root) {
+      CsrMatrix a;
+      a.rows = n;
+      a.row_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
+      Teuchos::Array<GO> cols(gathered->getGlobalMaxNumRowEntries());
+      Teuchos::Array<SC> vals(gathered->getGlobalMaxNumRowEntries());
+      for (GO i = 0; i < n; ++i) {
+        std::size_t count = 0;
+        gathered->getGlobalRowCopy(i, cols(), vals(), count);
+        std::vector<std::pair<GO, SC>> row;
+        for (std::size_t k = 0; k < count; ++k) row.emplace_back(cols[k], vals[k]);
+        std::sort(row.begin(), row.end());
+        for (const auto& [c, v] : row) a.cols.push_back(c), a.values.push_back(v);
+        a.row_ptr[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(a.cols.size());
+      }
+      stats = make_eigen_lu_solver()->solve(a, b, x);
+    }
+    Teuchos::broadcast<int, double>(*comm_, 0, static_cast<int>(n), x.data());
+    int ok = stats.converged ? 1 : 0;
+    Teuchos::broadcast<int, int>(*comm_, 0, 1, &ok);
+    stats.converged = ok != 0;
+    stats.iterations = 1;
+    return stats;
   }
 
   RCP<OP> make_preconditioner(const RCP<Matrix>& mat, const RCP<const Map>& map) const {
