@@ -107,6 +107,32 @@ TEST_F(Cli, ForceUntilAndOnlyParseInEveryForm) {
   EXPECT_NE(r.out.find("run   mesh          forced"), std::string::npos) << r.out;
 }
 
+TEST_F(Cli, EveryPreprocessingStageRunsAsAToolOfItsOwn) {
+  const std::string d = dir.string();
+  auto r = sh("phantom --preset case2-rca --out " + d + "/ph");
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = sh("centerline --lumen " + d + "/ph/lumen.vtp --out " + d + "/cl/centerline.vtp --true-centerline " + d +
+         "/ph/centerline_true.vtp");
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = sh("place --centerline " + d + "/cl/centerline.vtp --lumen " + d + "/ph/lumen.vtp --out " + d + "/pl");
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = sh("balloon --placement " + d + "/pl/placement.yaml --out " + d + "/b/balloon.vtu");
+  ASSERT_EQ(r.code, 0) << r.out;
+  stentsim::files::write_atomic(dir / "dev.yaml", "stent: {rings: 11}\n");
+  r = sh("stent --device " + d + "/dev.yaml --out " + d + "/s/stent.vtu");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(stentsim::files::read_text(dir / "s/summary.yaml").find("value: 588"), std::string::npos);
+  for (const char* f : {"ph/lumen.vtp", "cl/centerline.vtp", "cl/summary.yaml", "pl/placement.yaml",
+                        "pl/balloon_centerline.vtp", "b/balloon.vtu", "s/stent.vtu"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  stentsim::files::write_atomic(dir / "bad.yaml", "stent: {rngs: 11}\n");
+  r = sh("stent --device " + d + "/bad.yaml --out " + d + "/x.vtu");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("bad.yaml:1:9: stent.rngs: unknown key"), std::string::npos) << r.out;
+  r = sh("phantom --preset nonesuch --out " + d + "/x");
+  EXPECT_EQ(r.code, 2);
+}
+
 TEST_F(Cli, SolveRunsASceneAndRejectsBadOnes) {
   const std::string scene = std::string(STENTSIM_TEST_SOURCE_DIR) + "/examples/tube_inflation.yaml";
   auto r = sh("solve " + scene + " --out " + dir.string());

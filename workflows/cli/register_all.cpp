@@ -8,12 +8,14 @@ void register_init(CLI::App& app);
 void register_cohort(CLI::App& app);
 void register_solve(CLI::App& app);
 void register_segmentation(CLI::App& app);
+void register_device(CLI::App& app);
 
 void register_all(CLI::App& app) {
   register_init(app);
   register_run(app);
   register_cohort(app);
   register_segmentation(app);
+  register_device(app);
   register_solve(app);
   register_version(app);
 }
