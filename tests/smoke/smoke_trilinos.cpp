@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 int main(int argc, char** argv) {
   Tpetra::ScopeGuard scope(&argc, &argv);
@@ -66,7 +67,10 @@ int main(int argc, char** argv) {
   x->update(-1.0, *x_exact, 1.0);
   Teuchos::Array<SC> err(1);
   x->normInf(err());
-  const bool ok = result == Belos::Converged && err[0] < 1e-6;
+  // argv[1]: the rank count mpirun was asked for; a run that silently fell
+  // back to one process must not pass as the 2-rank test.
+  const int expected_ranks = argc > 1 ? std::atoi(argv[1]) : comm->getSize();
+  const bool ok = result == Belos::Converged && err[0] < 1e-6 && comm->getSize() == expected_ranks;
   if (comm->getRank() == 0)
     std::printf("trilinos smoke: ranks=%d iterations=%d max error=%.3e -> %s\n", comm->getSize(), solver->getNumIters(),
                 err[0], ok ? "ok" : "FAILED");
