@@ -11,26 +11,14 @@
 #include <string>
 
 #include "common/files.hpp"
+#include "tests/workflows/cli_runner.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out;
-};
-
-Result sh(const std::string& args) {
-  const char* bin = STENTSIM_TEST_BINARY;
-  std::string cmd = std::string(bin) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  int status = ::pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using Result = stentsim::testing::CliResult;
+Result sh(const std::string& args) { return stentsim::testing::run_stentsim(args); }
 
 class Cli : public ::testing::Test {
  protected:

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "common/files.hpp"
+#include "tests/workflows/cli_runner.hpp"
 #include "workflows/cohort/cohort_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -18,20 +19,8 @@ using stentsim::files::write_atomic;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out;
-};
-
-Result sh(const std::string& args) {
-  std::string cmd = std::string(STENTSIM_TEST_BINARY) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  int status = ::pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using Result = stentsim::testing::CliResult;
+Result sh(const std::string& args) { return stentsim::testing::run_stentsim(args); }
 
 class Cohort : public ::testing::Test {
  protected:
