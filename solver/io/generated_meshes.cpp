@@ -46,6 +46,24 @@ MeshData ring_sector_hex8(double ri, double ro, double angle_rad, double height,
     const double r = ri + (ro - ri) * i / nr, t = angle_rad * j / nt;
     return Eigen::Vector3d(r * std::cos(t), r * std::sin(t), height * k / nz);
   });
+  // A full ring: the last column of nodes (theta = 2 pi) is the first one.
+  if (angle_rad >= 2 * M_PI - 1e-12) {
+    const int per_layer = (nr + 1) * (nt + 1);
+    std::vector<std::int64_t> remap(m.points.size());
+    std::vector<Eigen::Vector3d> kept;
+    for (std::size_t id = 0; id < m.points.size(); ++id) {
+      const int local = static_cast<int>(id) % per_layer, j = local / (nr + 1);
+      if (j == nt) continue;
+      remap[id] = static_cast<std::int64_t>(kept.size());
+      kept.push_back(m.points[id]);
+    }
+    for (std::size_t id = 0; id < m.points.size(); ++id) {
+      const int local = static_cast<int>(id) % per_layer, j = local / (nr + 1);
+      if (j == nt) remap[id] = remap[id - static_cast<std::size_t>(nt * (nr + 1))];
+    }
+    for (auto& c : m.connectivity) c = remap[static_cast<std::size_t>(c)];
+    m.points = std::move(kept);
+  }
   DataArray radius;
   for (const auto& p : m.points) radius.values.push_back(std::hypot(p.x(), p.y()));
   m.point_data["ReferenceRadius"] = radius;

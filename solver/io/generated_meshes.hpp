@@ -11,7 +11,8 @@ MeshData box_hex8(int nx, int ny, int nz, double lx, double ly, double lz);
 
 /// Ring sector about the z axis: radius ri..ro (nr elements, spacing uniform),
 /// angle 0..angle_rad (nt elements), z in 0..height (nz elements).
-/// Point array "ReferenceRadius" is added for convenience.
+/// angle_rad = 2 pi closes the ring (shared seam nodes). Point array
+/// "ReferenceRadius" is added for convenience.
 MeshData ring_sector_hex8(double ri, double ro, double angle_rad, double height, int nr, int nt, int nz);
 
 /// Every hex8 into 6 tet4 around its 0-6 diagonal (conforming on structured meshes).
