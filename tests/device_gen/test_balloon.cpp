@@ -26,9 +26,15 @@ double hex_volume(const MeshData& m, std::size_t c) {
   return v;
 }
 
-int count_role(const MeshData& m, int role) {
+int count_faces(const MeshData& m, int group) {
   int k = 0;
-  for (double r : m.cell_data.at("CellRole").values) k += static_cast<int>(r) == role;
+  for (double r : m.cell_data.at(tags::kFaceGroup).values) k += static_cast<int>(r) == group;
+  return k;
+}
+
+int count_wall_cells(const MeshData& m) {
+  int k = 0;
+  for (double r : m.cell_data.at(tags::kLayer).values) k += static_cast<int>(r) == tags::balloon_wall;
   return k;
 }
 
@@ -39,12 +45,12 @@ TEST(DeviceGenBalloon, PaperCountsAndGeometryStraight) {
   EXPECT_EQ(d.around(), 29);
   EXPECT_EQ(d.along(), 44);
   const MeshData m = build_balloon_mesh(d, DeviceAxis::straight(d.length));
-  EXPECT_EQ(count_role(m, kBalloonSolid), 1276);
+  EXPECT_EQ(count_wall_cells(m), 1276);
   EXPECT_EQ(m.points.size(), 29u * 45u * 2u);
-  EXPECT_EQ(count_role(m, kBalloonInner), 1276);
-  EXPECT_EQ(count_role(m, kBalloonOuter), 1276);
-  EXPECT_EQ(count_role(m, kBalloonProximal), 29);
-  EXPECT_EQ(count_role(m, kBalloonDistal), 29);
+  EXPECT_EQ(count_faces(m, tags::balloon_inner), 1276);
+  EXPECT_EQ(count_faces(m, tags::balloon_outer), 1276);
+  EXPECT_EQ(count_faces(m, tags::balloon_end_proximal), 29);
+  EXPECT_EQ(count_faces(m, tags::balloon_end_distal), 29);
   const auto& tags = m.point_data.at("NodeTag");
   for (std::size_t i = 0; i < m.points.size(); ++i) {
     const int tag = static_cast<int>(tags.values[i]);
@@ -63,7 +69,7 @@ TEST(DeviceGenBalloon, PaperCountsAndGeometryStraight) {
   const double exact = 9.4 * 29 / 2.0 * std::sin(2 * std::numbers::pi / 29) * (0.49 * 0.49 - 0.45 * 0.45);
   EXPECT_NEAR(volume, exact, 1e-12);
   // Face normals point out of the wall.
-  const auto& role = m.cell_data.at("CellRole").values;
+  const auto& role = m.cell_data.at(tags::kFaceGroup).values;
   for (std::size_t c = 1276; c < m.num_cells(); ++c) {
     const auto n = m.cell(c);
     auto p = [&](int i) { return m.points[static_cast<std::size_t>(n[static_cast<std::size_t>(i)])]; };
@@ -71,10 +77,10 @@ TEST(DeviceGenBalloon, PaperCountsAndGeometryStraight) {
     const Eigen::Vector3d centre = 0.25 * (p(0) + p(1) + p(2) + p(3));
     const Eigen::Vector3d radial(centre.x(), centre.y(), 0.0);
     switch (static_cast<int>(role[c])) {
-      case kBalloonInner: EXPECT_LT(normal.dot(radial), 0.0); break;
-      case kBalloonOuter: EXPECT_GT(normal.dot(radial), 0.0); break;
-      case kBalloonProximal: EXPECT_LT(normal.z(), 0.0); break;
-      case kBalloonDistal: EXPECT_GT(normal.z(), 0.0); break;
+      case tags::balloon_inner: EXPECT_LT(normal.dot(radial), 0.0); break;
+      case tags::balloon_outer: EXPECT_GT(normal.dot(radial), 0.0); break;
+      case tags::balloon_end_proximal: EXPECT_LT(normal.z(), 0.0); break;
+      case tags::balloon_end_distal: EXPECT_GT(normal.z(), 0.0); break;
       default: ADD_FAILURE() << "unexpected face role";
     }
   }
@@ -84,7 +90,7 @@ TEST(DeviceGenBalloon, EighteenMillimetreCountsAndParsing) {
   auto cfg = ConfigMap::from_string("length: 18 mm\nelements_around: 35\nelements_along: 79\n", "case.yaml");
   const BalloonDesign d = parse_balloon_design(cfg);
   const MeshData m = build_balloon_mesh(d, DeviceAxis::straight(d.length));
-  EXPECT_EQ(count_role(m, kBalloonSolid), 2765);
+  EXPECT_EQ(count_wall_cells(m), 2765);
   EXPECT_EQ(m.points.size() * 3, 16800u);  // the paper's balloon DOFs
   BalloonDesign by_size;
   by_size.length = 18.0;
