@@ -13,6 +13,11 @@
 #include "common/log.hpp"
 #include "common/summary.hpp"
 #include "solver/assembly/parallel.hpp"
+#include "solver/beams/beam_loads.hpp"
+#include "solver/beams/beam_output.hpp"
+#include "solver/beams/beam_term.hpp"
+#include "solver/beams/direction_constraint.hpp"
+#include "solver/beams/rotation.hpp"
 #include "solver/io/results_writer.hpp"
 #include "solver/io/scene.hpp"
 #include "solver/io/solid_output.hpp"
@@ -60,15 +65,81 @@ std::vector<std::array<Vec3, 3>> cell_frames(const BodyDesc& b, const std::files
 struct Built {
   Model model;
   std::map<std::string, SolidBody*> bodies;
+  std::map<std::string, beams::BeamTerm*> beams;            // beam bodies (scene `beam:`)
+  std::map<std::string, const beams::BeamBodyDesc*> beam_desc;
+  std::map<std::string, Eigen::Vector3d> tip_rotation;      // accumulated rotation vector per QoI name
   std::vector<std::pair<std::string, FollowerPressure*>> pressures;
   std::vector<std::string> notes;
 };
+
+// Clamp, dead point force/moment and "moves only along a direction" on beam nodes.
+void add_beam_condition(const SceneDesc& scene, const ConditionDesc& c, Built& out,
+                        const std::map<std::string, GlobalDof>& multipliers) {
+  Model& model = out.model;
+  beams::BeamTerm& beam = *out.beams.at(c.body);
+  const beams::BeamBodyDesc& desc = *out.beam_desc.at(c.body);
+  const auto nodes = beams::select_beam_nodes(desc, c.node);
+  const LoadCurve curve = c.curve.empty() ? LoadCurve() : scene.curves.at(c.curve);
+  log::info("condition '{}': {} node(s) of beam body '{}' ({})", c.name, nodes.size(), c.body, c.node.describe());
+  std::size_t k = 0;
+  for (int n : nodes) {
+    const beams::BeamNodeDofs& d = beam.dofs()[static_cast<std::size_t>(n)];
+    auto fix3 = [&](const std::array<GlobalDof, 3>& dofs) {
+      for (GlobalDof g : dofs)
+        if (g >= 0) model.constraints.fix(g, [](double) { return 0.0; });
+    };
+    switch (c.type) {
+      case ConditionDesc::Type::clamp:
+        // Homogeneous: positions keep X, triads keep Λ₀ (rotation increments 0), tangents keep T₀.
+        if (c.clamp_position) fix3(d.pos);
+        if (c.clamp_rotation) fix3(d.rot);
+        if (c.clamp_tangent) fix3(d.tan);
+        break;
+      case ConditionDesc::Type::point_force:
+      case ConditionDesc::Type::point_moment:
+        model.add_term<beams::NodalLoadTerm>(fmt::format("{}@{}", c.name, n),
+                                             c.type == ConditionDesc::Type::point_force ? d.pos : d.rot, c.vector,
+                                             [curve](double t) { return curve(t); });
+        break;
+      case ConditionDesc::Type::direction: {
+        Eigen::Vector3d dir = c.vector;
+        if (c.direction_from_file) dir = desc.fixations[k].direction;
+        const GlobalDof m0 = multipliers.at(c.name) + 2 * static_cast<GlobalDof>(k);
+        model.add_term<beams::DirectionConstraintTerm>(fmt::format("{}@{}", c.name, n), d.pos, dir,
+                                                       std::array<GlobalDof, 2>{m0, m0 + 1});
+        break;
+      }
+      default:
+        throw std::logic_error("solid condition on a beam body");
+    }
+    ++k;
+  }
+}
 
 std::unique_ptr<Built> build(const SceneDesc& scene) {
   auto out = std::make_unique<Built>();
   Model& model = out->model;
   const std::string file = scene.file.string();
   for (const auto& b : scene.bodies) {
+    if (b.beam) {
+      // Beam DOFs from the model's DOF map: 9 per Hermite end node, 3 per middle node, 6 per Lagrange node.
+      const beams::BeamBodyDefinition& def = b.beam->body;
+      const GlobalDof count = beams::beam_nodal_dof_count(def);
+      const GlobalDof first = model.dofs.allocate(b.name, count);
+      GlobalDof next = 0;
+      auto dofs = beams::number_beam_dofs(def, first, &next);
+      if (next != first + count) throw std::logic_error("beam DOF numbering does not match its count");
+      out->beams[b.name] = &model.add_term<beams::BeamTerm>(b.name, def, std::move(dofs));
+      out->beam_desc[b.name] = &*b.beam;
+      out->notes.push_back(fmt::format("beam body {}: {} elements, {} nodal DOFs ({})", b.name, def.elements.size(), count,
+                                       b.beam->source));
+      log::info("beam body '{}': {} elements, {} nodes, {} nodal DOFs ({})", b.name, def.elements.size(), def.nodes.size(),
+                count, b.beam->source);
+      if (!b.beam->joints.empty())
+        log::warn("beam body '{}': {} joints in the file are not coupled (joint coupling: issue 8 part 2)", b.name,
+                  b.beam->joints.size());
+      continue;
+    }
     SolidBodySpec spec;
     spec.name = b.name;
     spec.mesh = b.mesh;
@@ -105,9 +176,20 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
     }
     log::info("body '{}': {} nodes, {} solid cells ({})", b.name, b.mesh.points.size(), solids, b.mesh_source);
   }
+  // Lagrange multipliers of "moves only along a direction" (their own DOFs, before constraints are sized).
+  std::map<std::string, GlobalDof> multipliers;  // condition name -> first multiplier DOF
+  for (const auto& c : scene.conditions) {
+    if (c.type != ConditionDesc::Type::direction) continue;
+    const auto nodes = beams::select_beam_nodes(*out->beam_desc.at(c.body), c.node);
+    multipliers[c.name] = model.dofs.allocate(c.name, 2 * static_cast<GlobalDof>(nodes.size()));
+  }
   model.size_constraints();
   std::map<GlobalDof, std::string> framed, globally_fixed;  // node first DOF -> condition name
   for (const auto& c : scene.conditions) {
+    if (out->beams.count(c.body)) {
+      add_beam_condition(scene, c, *out, multipliers);
+      continue;
+    }
     SolidBody& body = *out->bodies.at(c.body);
     const LoadCurve curve = c.curve.empty() ? LoadCurve() : scene.curves.at(c.curve);
     if (c.type != ConditionDesc::Type::dirichlet) {
@@ -161,7 +243,32 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
   return out;
 }
 
-double qoi_value(const QoiDesc& q, const Built& b, const Eigen::VectorXd& u) {
+int qoi_beam_node(const QoiDesc& q, const Built& b) {
+  return beams::select_beam_nodes(*b.beam_desc.at(q.body), q.node).at(0);
+}
+
+/// Accumulates the tip rotation vectors after each converged step (the angle is unwrapped across ±π).
+void track_tip_rotations(const SceneDesc& scene, Built& b) {
+  for (const auto& q : scene.qois) {
+    if (q.type != QoiDesc::Type::tip_rotation_angle) continue;
+    const beams::BeamTerm& beam = *b.beams.at(q.body);
+    const int n = qoi_beam_node(q, b);
+    const Eigen::Quaterniond rel = beam.rotation(n) * beam.body().nodes[static_cast<std::size_t>(n)].triad.conjugate();
+    auto [it, fresh] = b.tip_rotation.try_emplace(q.name, Eigen::Vector3d::Zero());
+    it->second = beams::unwrap_rotation_vector(rel, it->second);
+  }
+}
+
+/// Value of a QoI at u (tip_position: 3 numbers).
+std::vector<double> qoi_values(const QoiDesc& q, const Built& b, const Eigen::VectorXd& u) {
+  if (q.type == QoiDesc::Type::tip_position) {
+    const Eigen::Vector3d r = b.beams.at(q.body)->position(u, qoi_beam_node(q, b));
+    return {r.x(), r.y(), r.z()};
+  }
+  if (q.type == QoiDesc::Type::tip_rotation_angle) {
+    auto it = b.tip_rotation.find(q.name);
+    return {it == b.tip_rotation.end() ? 0.0 : it->second.norm()};
+  }
   const SolidBody& body = *b.bodies.at(q.body);
   const auto nodes = select_nodes(body.mesh(), q.where);
   if (nodes.empty()) throw InputError(fmt::format("qoi '{}': the node selection ({}) is empty", q.name, q.where.describe()));
@@ -174,7 +281,7 @@ double qoi_value(const QoiDesc& q, const Built& b, const Eigen::VectorXd& u) {
       acc = std::max(acc, u.segment<3>(body.dof(n, 0)).norm());
     }
   }
-  return q.type == QoiDesc::Type::mean_radius ? acc / static_cast<double>(nodes.size()) : acc;
+  return {q.type == QoiDesc::Type::mean_radius ? acc / static_cast<double>(nodes.size()) : acc};
 }
 
 }  // namespace
@@ -216,6 +323,8 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   auto frame = [&](double t) {
     std::vector<std::pair<std::string, MeshData>> meshes;
     for (const auto& [name, body] : built->bodies) meshes.emplace_back(name, solid_output(*body, u));
+    // Beams: their own VTU per frame (sampled centerline, Radius, triads, section forces) in the same PVD.
+    for (const auto& [name, beam] : built->beams) meshes.emplace_back(name, beams::beam_output_mesh(*beam, u));
     writer.write_frame(writer.frames(), t, meshes);
   };
   frame(scene.stepping.t_start);
@@ -225,7 +334,7 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   writer.history_header(columns);
 
   Summary summary;
-  std::map<std::string, double> qoi;
+  std::map<std::string, std::vector<double>> qoi;
   long newton_total = 0, linear_total = 0, cuts_total = 0;
   int steps = 0;
   double t_last = scene.stepping.t_start;
@@ -245,8 +354,9 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
     bool at_stop = std::abs(r.time - scene.stepping.t_end) < tol;
     for (double s : scene.stepping.stops) at_stop = at_stop || std::abs(r.time - s) < tol;
     if (r.step % scene.output_every == 0 || at_stop) frame(r.time);
+    track_tip_rotations(scene, *built);
     for (const auto& q : scene.qois)
-      if (std::abs(r.time - q.time) < tol) qoi[q.name] = qoi_value(q, *built, u);
+      if (std::abs(r.time - q.time) < tol) qoi[q.name] = qoi_values(q, *built, u);
   };
   GlobalSystem system(model.constraints);
   int status = 0;
@@ -261,7 +371,9 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
     log::error("the last converged state (t = {:.6g}) is in {}", t_last, (out_dir / "results.pvd").string());
   }
   for (const auto& q : scene.qois) {
-    if (qoi.count(q.name)) summary.set(q.name, qoi[q.name], q.type == QoiDesc::Type::mean_radius ? "mm" : "mm");
+    if (!qoi.count(q.name)) continue;
+    if (q.type == QoiDesc::Type::tip_position) summary.set(q.name, qoi[q.name], "mm");
+    else summary.set(q.name, qoi[q.name][0], q.type == QoiDesc::Type::tip_rotation_angle ? "rad" : "mm");
   }
   summary.set_text("status", status == 0 ? "completed" : "failed");
   if (!failure.empty()) summary.note("failure", failure);

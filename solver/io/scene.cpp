@@ -112,11 +112,22 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   scene.file = file;
   scene.description = root.string("description", "");
 
-  std::set<std::string> names;
+  std::set<std::string> names, beam_names;
   for (auto& b : root.map_list("bodies")) {
     BodyDesc body;
     body.name = b.string("name");
     if (!names.insert(body.name).second) b.fail("name", fmt::format("body name '{}' is used twice", body.name));
+    if (b.has("beam") == b.has("mesh")) b.fail("", "a body needs exactly one of 'mesh' (a solid) or 'beam'");
+    if (b.has("beam")) {
+      ConfigMap beam = b.map("beam");
+      body.beam = beams::read_beam_body(beam);
+      beam.finish();
+      body.mesh_source = body.beam->source;
+      b.finish();
+      beam_names.insert(body.name);
+      scene.bodies.push_back(std::move(body));
+      continue;
+    }
     ConfigMap mesh = b.map("mesh");
     body.mesh = read_mesh(mesh, body.mesh_source);
     mesh.finish();
@@ -182,14 +193,83 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   auto check_body = [&](ConfigMap& c, const std::string& name) {
     if (!names.count(name)) c.fail("body", fmt::format("no body named '{}'", name));
   };
+  // Solid conditions/QoIs need a solid body, beam ones a beam body.
+  auto check_kind = [&](ConfigMap& c, const std::string& name, bool beam, const std::string& type) {
+    if (beam_names.count(name) != static_cast<std::size_t>(beam))
+      c.fail("body", fmt::format("'{}' applies to {} bodies; '{}' is a {} body", type, beam ? "beam" : "solid", name,
+                                 beam_names.count(name) ? "beam" : "solid"));
+  };
+  auto beam_body = [&](const std::string& name) -> const beams::BeamBodyDesc& {
+    for (const auto& b : scene.bodies)
+      if (b.name == name) return *b.beam;
+    throw std::logic_error("beam body lookup");
+  };
+  // A beam node selection must select something (file:line of the key).
+  auto check_nodes = [&](ConfigMap& c, const std::string& body, const beams::BeamNodeSelector& sel) {
+    if (beams::select_beam_nodes(beam_body(body), sel).empty())
+      c.fail("node", fmt::format("selects no end node of beam body '{}' ({})", body, sel.describe()));
+  };
 
   int index = 0;
   for (auto& c : root.map_list("conditions")) {
     ConditionDesc d;
-    const std::string type = c.choice("type", {"pressure", "springs", "dirichlet"});
+    const std::string type =
+        c.choice("type", {"pressure", "springs", "dirichlet", "clamp", "point_force", "point_moment", "direction"});
     d.name = c.string("name", fmt::format("{}_{}", type, index++));
     d.body = c.string("body");
     check_body(c, d.body);
+    const bool beam_type = type == "clamp" || type == "point_force" || type == "point_moment" || type == "direction";
+    check_kind(c, d.body, beam_type, type);
+    if (beam_type) {
+      d.node = beams::read_beam_node_selector(c, "node");
+      check_nodes(c, d.body, d.node);
+      if (type == "clamp") {
+        d.type = ConditionDesc::Type::clamp;
+        // Hermite ends: position + rotation by default; the tangent carries the root shear strain.
+        std::vector<std::string> fix{"position", "rotation"};
+        if (c.has("fix")) {  // words: "position rotation tangent" (any of them)
+          const std::string text = c.string("fix");
+          fix.clear();
+          std::string w;
+          for (std::size_t i = 0; i <= text.size(); ++i) {
+            if (i == text.size() || text[i] == ' ' || text[i] == ',') {
+              if (w.empty()) continue;
+              if (w != "position" && w != "rotation" && w != "tangent")
+                c.fail("fix", fmt::format("'{}' is not one of position, rotation, tangent", w));
+              fix.push_back(w);
+              w.clear();
+            } else {
+              w += text[i];
+            }
+          }
+          if (fix.empty()) c.fail("fix", "expected some of: position rotation tangent");
+        }
+        d.clamp_position = std::find(fix.begin(), fix.end(), "position") != fix.end();
+        d.clamp_rotation = std::find(fix.begin(), fix.end(), "rotation") != fix.end();
+        d.clamp_tangent = std::find(fix.begin(), fix.end(), "tangent") != fix.end();
+        if (d.clamp_tangent && beam_body(d.body).body.interpolation != beams::BeamInterpolation::hermite3)
+          c.fail("fix", "only Hermite (hermite3) beams have tangent DOFs");
+      } else if (type == "direction") {
+        d.type = ConditionDesc::Type::direction;
+        if (c.has("direction") && c.node()["direction"].IsScalar()) {
+          if (c.choice("direction", {"file"}) == "file") d.direction_from_file = true;
+          if (d.node.kind != beams::BeamNodeSelector::Kind::fixations)
+            c.fail("direction", "'file' takes the stent file's fixation directions; it needs node: fixations");
+        } else {
+          d.vector = vec3(c, "direction");
+          if (!(d.vector.norm() > 0)) c.fail("direction", "must be a non-zero vector");
+          d.vector.normalize();
+        }
+      } else {
+        d.type = type == "point_force" ? ConditionDesc::Type::point_force : ConditionDesc::Type::point_moment;
+        d.vector = vec3(c, "value");  // N (force) or N mm (moment), dead (fixed in space)
+        d.curve = c.string("curve", "");
+      }
+      check_curve(c, d.curve);
+      c.finish();
+      scene.conditions.push_back(d);
+      continue;
+    }
     if (type == "pressure") {
       d.type = ConditionDesc::Type::pressure;
       d.where = read_selector(c, "surface");
@@ -270,11 +350,23 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   for (auto& q : root.map_list("qoi")) {
     QoiDesc d;
     d.name = q.string("name");
-    const std::string type = q.choice("type", {"mean_radius", "max_displacement"});
-    d.type = type == "mean_radius" ? QoiDesc::Type::mean_radius : QoiDesc::Type::max_displacement;
+    const std::string type = q.choice("type", {"mean_radius", "max_displacement", "tip_position", "tip_rotation_angle"});
+    d.type = type == "mean_radius"        ? QoiDesc::Type::mean_radius
+             : type == "max_displacement" ? QoiDesc::Type::max_displacement
+             : type == "tip_position"     ? QoiDesc::Type::tip_position
+                                          : QoiDesc::Type::tip_rotation_angle;
     d.body = q.string("body");
     check_body(q, d.body);
-    d.where = read_selector(q, "nodes");
+    const bool beam_qoi = d.type == QoiDesc::Type::tip_position || d.type == QoiDesc::Type::tip_rotation_angle;
+    check_kind(q, d.body, beam_qoi, type);
+    if (beam_qoi) {
+      d.node = beams::read_beam_node_selector(q, "node");
+      if (d.node.kind == beams::BeamNodeSelector::Kind::fixations) q.fail("node", "a tip QoI needs one node (first, last or a point)");
+      check_nodes(q, d.body, d.node);
+      if (beams::select_beam_nodes(beam_body(d.body), d.node).size() != 1) q.fail("node", "selects more than one node");
+    } else {
+      d.where = read_selector(q, "nodes");
+    }
     if (d.type == QoiDesc::Type::mean_radius) {
       ConfigMap ax = q.map("axis");
       d.axis_origin = vec3(ax, "origin", Vec3::Zero());

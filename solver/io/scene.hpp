@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/mesh_data.hpp"
+#include "solver/beams/beam_scene.hpp"
 #include "solver/io/selection.hpp"
 #include "solver/linalg/linear_solver.hpp"
 #include "solver/materials/material.hpp"
@@ -29,6 +30,8 @@ struct FrameSource {
 
 struct BodyDesc {
   std::string name;
+  /// A beam body (`beam:` in the scene, solver/beams/beam_scene.hpp) instead of a solid mesh.
+  std::optional<beams::BeamBodyDesc> beam;
   MeshData mesh;
   std::string mesh_source;                  // file name or generator, for the summary
   std::string tag_array;                    // cell array with the material tag ("" = one material)
@@ -37,20 +40,29 @@ struct BodyDesc {
 };
 
 struct ConditionDesc {
-  enum class Type { pressure, springs, dirichlet } type = Type::pressure;
+  // pressure, springs, dirichlet: solid bodies. clamp, point_force,
+  // point_moment, direction: beam bodies (node by beams::BeamNodeSelector).
+  enum class Type { pressure, springs, dirichlet, clamp, point_force, point_moment, direction } type = Type::pressure;
   std::string name, body, curve;            // curve "" = constant 1
   Selector where;
   double value = 0.0;                       // pressure (MPa), stiffness (N/mm^3) or displacement (mm)
   std::vector<int> components;              // dirichlet: 0,1,2 (global axes)
   bool radial_only = false;                 // dirichlet: fix the circumferential and axial components
   Vec3 axis_origin = Vec3::Zero(), axis = Vec3::UnitZ();
+  // beam conditions
+  beams::BeamNodeSelector node;
+  bool clamp_position = true, clamp_rotation = true, clamp_tangent = false;
+  Vec3 vector = Vec3::Zero();               // point_force (N), point_moment (N mm), direction
+  bool direction_from_file = false;         // direction: the stent file's fixation directions
 };
 
 struct QoiDesc {
   std::string name;
-  enum class Type { mean_radius, max_displacement } type = Type::mean_radius;
+  // tip_position (vector, mm) and tip_rotation_angle (rad, accumulated over steps): beam bodies
+  enum class Type { mean_radius, max_displacement, tip_position, tip_rotation_angle } type = Type::mean_radius;
   std::string body;
   Selector where;
+  beams::BeamNodeSelector node;
   Vec3 axis_origin = Vec3::Zero(), axis = Vec3::UnitZ();
   double time = 0.0;                        // evaluated at the output step at this time
 };
