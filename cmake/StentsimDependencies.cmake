@@ -54,6 +54,16 @@ add_library(stentsim_gmsh INTERFACE)
 target_include_directories(stentsim_gmsh INTERFACE ${GMSH_INCLUDE_DIR})
 target_link_libraries(stentsim_gmsh INTERFACE ${GMSH_LIBRARY})
 
+# PLplot (C API) for headless PNG/SVG figures; the cairo devices come from
+# plplot-driver-cairo (checked at run time, the driver is a plugin).
+find_package(PkgConfig QUIET)
+if(PkgConfig_FOUND)
+  pkg_check_modules(PLPLOT QUIET IMPORTED_TARGET plplot)
+endif()
+stentsim_require(PLPLOT_FOUND "libplplot-dev plplot-driver-cairo" "PLplot (pkg-config plplot)")
+add_library(stentsim_plplot INTERFACE)
+target_link_libraries(stentsim_plplot INTERFACE PkgConfig::PLPLOT)
+
 # Trilinos 13.2. Debian's config can report "found" while a component's
 # library list is empty: check each one.
 set(STENTSIM_TRILINOS_COMPONENTS Tpetra Belos Ifpack2 MueLu Amesos2 Teuchos)

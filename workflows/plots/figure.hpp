@@ -1,0 +1,75 @@
+#pragma once
+// A small plotting adapter: 2-D figures (several series, linear or log axes,
+// labels with units, legend, highlighted points) written as PNG or SVG.
+// The drawing library (PLplot, cairo devices) stays in figure.cpp; this header
+// only describes what to draw. Rendering is serialized inside the adapter
+// because PLplot keeps global state and is not thread-safe.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stentsim::plots {
+
+/// How a series is drawn.
+enum class Style { lines, markers, lines_and_markers };
+
+/// Marker shapes (cycled per series when left at `automatic`).
+enum class Marker { automatic, circle, square, triangle, diamond, cross };
+
+/// One data series. Non-finite (NaN/inf) y values are gaps: lines break there
+/// and no marker is drawn, so a failed case simply has no point.
+struct Series {
+  std::string label;  ///< legend text; empty = not in the legend
+  std::vector<double> x;
+  std::vector<double> y;
+  Style style = Style::lines;
+  Marker marker = Marker::automatic;
+};
+
+/// Points drawn on top of every series, larger and outlined (e.g. a Pareto
+/// front, or the failed cases of a cohort). `connect` joins them in x order.
+struct Highlight {
+  std::string label;  ///< legend text; empty = not in the legend
+  std::vector<double> x;
+  std::vector<double> y;
+  Marker marker = Marker::circle;
+  bool connect = false;
+  bool warning_colour = false;  ///< red instead of the highlight gold
+};
+
+struct Axis {
+  std::string label;  ///< e.g. "lumen diameter"
+  std::string unit;   ///< e.g. "mm"; printed as "label [unit]"; empty = dimensionless
+  bool log = false;   ///< base-10 log scale; every plotted value must then be > 0
+  std::optional<double> min, max;  ///< fixed range; otherwise data range + 5 % margin
+  /// Categorical ticks: tick_labels[i] is written at x = i (integer ticks only).
+  std::vector<std::string> tick_labels;
+};
+
+struct Figure {
+  std::string title;
+  Axis x, y;
+  std::vector<Series> series;
+  std::vector<Highlight> highlights;
+  int width_px = 900;
+  int height_px = 600;
+  bool legend = true;
+};
+
+/// "label [unit]" (or just the label when the unit is empty).
+std::string axis_title(const Axis& axis);
+
+/// Writes the figure as PNG (device pngcairo), atomically (temporary name in
+/// the same folder, then rename). Throws InputError for a figure that cannot be
+/// drawn (no data, mismatched x/y sizes, non-positive values on a log axis) and
+/// ComputeError when the device fails to produce the file.
+void write_png(const Figure& figure, const std::filesystem::path& target);
+
+/// Same as write_png with the svgcairo device.
+void write_svg(const Figure& figure, const std::filesystem::path& target);
+
+/// Writes PNG or SVG by the target's extension (".png" / ".svg").
+void write_figure(const Figure& figure, const std::filesystem::path& target);
+
+}  // namespace stentsim::plots
