@@ -1,0 +1,316 @@
+#include "fibers/harmonic_fibers.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "common/error.hpp"
+#include "common/mesh_tags.hpp"
+#include "fibers/laplace_field.hpp"
+#include "solver/fem/boundary_faces.hpp"
+
+namespace stentsim::fibers {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+void push(DataArray& a, const Vec3& v) { a.values.insert(a.values.end(), {v.x(), v.y(), v.z()}); }
+Vec3 get(const DataArray& a, std::size_t c) { return {a.at(c, 0), a.at(c, 1), a.at(c, 2)}; }
+double angle_deg(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180.0 / M_PI; }
+
+/// The centerline as chains of points with unit tangents at the points
+/// (central differences), so that the tangent interpolated along a segment
+/// is continuous from one segment to the next.
+struct Centerline {
+  std::vector<std::vector<Vec3>> points, tangents;
+
+  explicit Centerline(const MeshData& cl, const std::string& source) {
+    for (std::size_t c = 0; c < cl.num_cells(); ++c) {
+      const auto t = cl.cell_types[c];
+      if (t != CellType::line && t != CellType::polyline) continue;
+      std::vector<Vec3> chain;
+      for (auto p : cl.cell(c)) {
+        const Vec3& x = cl.points[static_cast<std::size_t>(p)];
+        if (chain.empty() || (x - chain.back()).norm() > 1e-12) chain.push_back(x);
+      }
+      // Consecutive two-point line cells that continue each other form one chain.
+      if (!points.empty() && t == CellType::line && chain.size() == 2 && (points.back().back() - chain.front()).norm() < 1e-12)
+        points.back().push_back(chain.back());
+      else if (chain.size() >= 2) points.push_back(std::move(chain));
+    }
+    if (points.empty()) throw InputError(fmt::format("fibers: centerline {} has no line with two distinct points", source));
+    for (const auto& ch : points) {
+      std::vector<Vec3> tg(ch.size());
+      for (std::size_t i = 0; i < ch.size(); ++i) {
+        const Vec3 d = ch[std::min(i + 1, ch.size() - 1)] - ch[i == 0 ? 0 : i - 1];
+        tg[i] = d.normalized();
+      }
+      tangents.push_back(std::move(tg));
+    }
+  }
+
+  /// Unit tangent at the point of the centerline closest to x.
+  Vec3 tangent_at(const Vec3& x) const {
+    double best = INFINITY;
+    Vec3 t = Vec3::UnitZ();
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const auto& ch = points[k];
+      for (std::size_t i = 0; i + 1 < ch.size(); ++i) {
+        const Vec3 d = ch[i + 1] - ch[i];
+        const double s = std::clamp((x - ch[i]).dot(d) / d.squaredNorm(), 0.0, 1.0);
+        const double dist = (ch[i] + s * d - x).squaredNorm();
+        if (dist < best) {
+          best = dist;
+          t = ((1 - s) * tangents[k][i] + s * tangents[k][i + 1]).normalized();
+        }
+      }
+    }
+    return t;
+  }
+};
+
+/// Nodes of the faces of each group (all nodes of a face, mid-edge nodes included).
+std::map<int, std::set<std::int64_t>> face_group_nodes(const MeshData& mesh, const std::string& source) {
+  const auto it = mesh.cell_data.find(tags::kFaceGroup);
+  if (it == mesh.cell_data.end())
+    throw InputError(fmt::format("fibers: {} has no cell array '{}' (boundary faces tagged endothelium 1, outer_wall 2, "
+                                 "proximal_cut 3, distal_cut 4)", source, tags::kFaceGroup));
+  std::map<int, std::set<std::int64_t>> nodes;
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    const auto t = mesh.cell_types[c];
+    if (t != CellType::triangle && t != CellType::quadratic_triangle && t != CellType::quad) continue;
+    const int g = static_cast<int>(it->second.at(c));
+    for (auto p : mesh.cell(c)) nodes[g].insert(p);
+  }
+  for (int g : {tags::endothelium, tags::outer_wall, tags::proximal_cut, tags::distal_cut})
+    if (nodes[g].empty())
+      throw InputError(fmt::format("fibers: {} has no boundary faces with {} = {} ({})", source, tags::kFaceGroup, g,
+                                   tags::face_group_name(g)));
+  return nodes;
+}
+
+std::map<std::int64_t, double> dirichlet(const std::set<std::int64_t>& zero, const std::set<std::int64_t>& one,
+                                         const char* what, const std::string& source) {
+  std::map<std::int64_t, double> d;
+  for (auto n : zero) d[n] = 0.0;
+  for (auto n : one) {
+    if (d.count(n))
+      throw InputError(fmt::format("fibers: {}: node {} lies on both boundaries of the {} problem", source, n, what));
+    d[n] = 1.0;
+  }
+  return d;
+}
+
+/// Per volume cell, the gradient of `u` at the cell's centroid. For tet4 the
+/// element gradient is constant and only first-order accurate in direction
+/// (it ignores the curvature of the iso-surfaces within the element), so it is
+/// replaced by the mean of the recovered nodal gradients at its corners (each
+/// the volume-weighted mean of the gradients of the tet4 cells around the
+/// node; Zienkiewicz-Zhu averaging), which is second-order on smooth meshes.
+std::vector<Vec3> cell_gradients(const MeshData& mesh, const Eigen::VectorXd& u) {
+  std::vector<Vec3> nodal(mesh.points.size(), Vec3::Zero());
+  std::vector<double> weight(mesh.points.size(), 0.0);
+  std::vector<Vec3> out;
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    if (mesh.cell_types[c] != CellType::tetra) continue;
+    const auto n = mesh.cell(c);
+    const auto& p = mesh.points;
+    const double vol = std::abs((p[n[1]] - p[n[0]]).cross(p[n[2]] - p[n[0]]).dot(p[n[3]] - p[n[0]])) / 6;
+    const Vec3 g = centroid_gradient(mesh, c, u);
+    for (auto k : n) nodal[static_cast<std::size_t>(k)] += vol * g, weight[static_cast<std::size_t>(k)] += vol;
+  }
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    if (!is_volume_cell(mesh.cell_types[c])) continue;
+    if (mesh.cell_types[c] != CellType::tetra) {
+      out.push_back(centroid_gradient(mesh, c, u));
+      continue;
+    }
+    Vec3 g = Vec3::Zero();
+    for (auto k : mesh.cell(c)) g += nodal[static_cast<std::size_t>(k)] / weight[static_cast<std::size_t>(k)];
+    out.push_back(g / 4);
+  }
+  return out;
+}
+
+}  // namespace
+
+FiberQuality fiber_quality(const MeshData& f) {
+  FiberQuality q;
+  q.min_handedness = INFINITY;
+  const auto& r = f.cell_data.at("Radial");
+  const auto& c = f.cell_data.at("Circumferential");
+  const auto& l = f.cell_data.at("Longitudinal");
+  const auto& f1 = f.cell_data.at("Fiber1");
+  const auto& f2 = f.cell_data.at("Fiber2");
+  const auto& layer = f.cell_data.at(tags::kLayer);
+  for (std::size_t e = 0; e < f.num_cells(); ++e) {
+    Eigen::Matrix3d m;
+    m << get(r, e), get(c, e), get(l, e);
+    q.orthonormality_error = std::max(q.orthonormality_error, (m.transpose() * m - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
+    q.min_handedness = std::min(q.min_handedness, m.determinant());
+  }
+  // Face neighbours: cells bounded by the same face are found by the face's
+  // sorted corner nodes (the inner faces boundary_faces() drops).
+  std::map<std::array<std::int64_t, 4>, std::size_t> seen;
+  auto visit = [&](std::array<std::int64_t, 4> key, std::size_t e) {
+    std::sort(key.begin(), key.end());
+    auto [it, fresh] = seen.emplace(key, e);
+    if (fresh) return;
+    const std::size_t o = it->second;
+    for (const auto* a : {&r, &c, &l})
+      q.max_neighbour_frame_angle_deg = std::max(q.max_neighbour_frame_angle_deg, angle_deg(get(*a, e), get(*a, o)));
+    if (layer.at(e) == layer.at(o))
+      for (const auto* a : {&f1, &f2})
+        q.max_neighbour_fiber_angle_deg = std::max(q.max_neighbour_fiber_angle_deg, angle_deg(get(*a, e), get(*a, o)));
+  };
+  static constexpr int kTetFaces[4][3] = {{0, 1, 2}, {0, 1, 3}, {1, 2, 3}, {0, 2, 3}};
+  static constexpr int kHexFaces[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  for (std::size_t e = 0; e < f.num_cells(); ++e) {
+    const auto n = f.cell(e);
+    if (f.cell_types[e] == CellType::hexahedron) {
+      for (const auto& fc : kHexFaces) visit({n[fc[0]], n[fc[1]], n[fc[2]], n[fc[3]]}, e);
+    } else {
+      for (const auto& fc : kTetFaces) visit({-1, n[fc[0]], n[fc[1]], n[fc[2]]}, e);
+    }
+  }
+  if (f.point_data.count("Transmural")) {
+    std::set<std::int64_t> vol(f.connectivity.begin(), f.connectivity.end());
+    const auto& t = f.point_data.at("Transmural");
+    const auto& lc = f.point_data.at("LongitudinalCoordinate");
+    q.transmural_min = q.longitudinal_min = INFINITY;
+    q.transmural_max = q.longitudinal_max = -INFINITY;
+    for (auto p : vol) {
+      const auto i = static_cast<std::size_t>(p);
+      q.transmural_min = std::min(q.transmural_min, t.at(i));
+      q.transmural_max = std::max(q.transmural_max, t.at(i));
+      q.longitudinal_min = std::min(q.longitudinal_min, lc.at(i));
+      q.longitudinal_max = std::max(q.longitudinal_max, lc.at(i));
+    }
+  }
+  return q;
+}
+
+HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& centerline_data, const HarmonicFiberOptions& o,
+                                    const std::string& source) {
+  if (!(o.centerline_weight >= 0 && o.centerline_weight <= 1))
+    throw InputError(fmt::format("fibers: centerline_weight must lie in [0, 1], got {}", o.centerline_weight));
+  const auto layer_it = mesh.cell_data.find(tags::kLayer);
+  if (layer_it == mesh.cell_data.end()) throw InputError(fmt::format("fibers: {} has no cell array '{}'", source, tags::kLayer));
+  std::size_t volume_cells = 0;
+  for (auto t : mesh.cell_types) volume_cells += is_volume_cell(t) ? 1 : 0;
+  if (volume_cells == 0) throw InputError(fmt::format("fibers: {} has no volume cells (hex8, tet4, tet10)", source));
+  const auto groups = face_group_nodes(mesh, source);
+  const Centerline centerline(centerline_data, source);
+
+  HarmonicFiberResult res;
+  const auto t0 = std::chrono::steady_clock::now();
+  const LaplaceSolve t = solve_laplace(mesh, dirichlet(groups.at(tags::endothelium), groups.at(tags::outer_wall), "transmural", source),
+                                       o.linear_solver);
+  const LaplaceSolve l = solve_laplace(mesh, dirichlet(groups.at(tags::proximal_cut), groups.at(tags::distal_cut), "longitudinal", source),
+                                       o.linear_solver);
+  res.laplace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.transmural_residual = t.relative_residual;
+  res.longitudinal_residual = l.relative_residual;
+  res.transmural_iterations = t.iterations;
+  res.longitudinal_iterations = l.iterations;
+
+  // Per cell: radial from grad t, the tangent and grad l.
+  struct CellFrame {
+    Vec3 radial, tangent, grad_l;
+  };
+  std::vector<CellFrame> frames;
+  frames.reserve(volume_cells);
+  double orientation = 0;  // sum of tangent . grad l: the centerline may run distal -> proximal
+  const std::vector<Vec3> grad_t = cell_gradients(mesh, t.u), grad_l = cell_gradients(mesh, l.u);
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    if (!is_volume_cell(mesh.cell_types[c])) continue;
+    const Vec3 gt = grad_t[frames.size()], gl = grad_l[frames.size()];
+    if (!(gt.norm() > 1e-12) || !(gl.norm() > 1e-12))
+      throw ComputeError(fmt::format("fibers: {} cell {}: vanishing gradient of the {} coordinate", source, c,
+                                     gt.norm() > 1e-12 ? "longitudinal" : "transmural"));
+    Vec3 x = Vec3::Zero();
+    const auto nodes = mesh.cell(c);
+    for (auto p : nodes) x += mesh.points[static_cast<std::size_t>(p)];
+    x /= static_cast<double>(nodes.size());
+    frames.push_back({gt.normalized(), centerline.tangent_at(x), gl.normalized()});
+    orientation += frames.back().tangent.dot(frames.back().grad_l);
+  }
+  const double sign = orientation < 0 ? -1.0 : 1.0;
+
+  MeshData& out = res.fibers;
+  out.points = mesh.points;
+  DataArray radial{3, {}}, circ{3, {}}, longi{3, {}}, f1{3, {}}, f2{3, {}}, layer{1, {}}, tc{1, {}}, lc{1, {}};
+  std::size_t k = 0;
+  double blend_max = 0;
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    if (!is_volume_cell(mesh.cell_types[c])) continue;
+    const CellFrame& fr = frames[k++];
+    const int lay = static_cast<int>(layer_it->second.at(c));
+    const auto a = o.angles.find(lay);
+    if (a == o.angles.end())
+      throw InputError(fmt::format("fibers: no fiber angle for layer {} ({}, cell {} of {})", lay, tags::layer_name(lay), c, source));
+    const Vec3 er = fr.radial;
+    auto project = [&](const Vec3& v) { return v - v.dot(er) * er; };
+    const Vec3 tang = project(sign * fr.tangent), gl = project(fr.grad_l);
+    if (tang.norm() > 1e-8 && gl.norm() > 1e-8) blend_max = std::max(blend_max, angle_deg(tang.normalized(), gl.normalized()));
+    const Vec3 blended = project(o.centerline_weight * sign * fr.tangent + (1 - o.centerline_weight) * fr.grad_l);
+    if (!(blended.norm() > 1e-8))
+      throw ComputeError(fmt::format("fibers: {} cell {}: the longitudinal direction is parallel to grad t", source, c));
+    const Vec3 el = blended.normalized();
+    const Vec3 ec = el.cross(er);  // e_r x e_c = e_l: right-handed (radial, circumferential, longitudinal)
+    push(radial, er);
+    push(circ, ec);
+    push(longi, el);
+    push(f1, std::cos(a->second) * ec + std::sin(a->second) * el);
+    push(f2, std::cos(a->second) * ec - std::sin(a->second) * el);
+    layer.values.push_back(lay);
+    tc.values.push_back(centroid_value(mesh, c, t.u));
+    lc.values.push_back(centroid_value(mesh, c, l.u));
+    out.add_cell(mesh.cell_types[c], mesh.cell(c));
+  }
+  out.cell_data["Radial"] = std::move(radial);
+  out.cell_data["Circumferential"] = std::move(circ);
+  out.cell_data["Longitudinal"] = std::move(longi);
+  out.cell_data["Fiber1"] = std::move(f1);
+  out.cell_data["Fiber2"] = std::move(f2);
+  out.cell_data[tags::kLayer] = std::move(layer);
+  out.cell_data["Transmural"] = std::move(tc);
+  out.cell_data["LongitudinalCoordinate"] = std::move(lc);
+  out.point_data["Transmural"] = {1, std::vector<double>(t.u.data(), t.u.data() + t.u.size())};
+  out.point_data["LongitudinalCoordinate"] = {1, std::vector<double>(l.u.data(), l.u.data() + l.u.size())};
+  out.field_text["method"] = fmt::format("harmonic lifting (centerline weight {})", o.centerline_weight);
+  res.quality = fiber_quality(out);
+  res.quality.tangent_blend_angle_max_deg = blend_max;
+  return res;
+}
+
+void write_harmonic_fibers(const std::string& artery_vtu, const std::string& centerline_vtp, const HarmonicFiberOptions& o,
+                           const std::string& fibers_vtu, Summary& summary) {
+  const auto r = harmonic_fibers(read_vtu(artery_vtu), read_vtp(centerline_vtp), o, artery_vtu);
+  write_vtu(fibers_vtu, r.fibers);
+  const auto& q = r.quality;
+  summary.set("fiber_elements", static_cast<double>(r.fibers.num_cells()));
+  summary.set("fiber_nodes", static_cast<double>(r.fibers.points.size()));
+  for (const auto& [l, phi] : o.angles) summary.set(std::string("fiber_angle_") + tags::layer_name(l), phi * 180 / M_PI, "deg");
+  summary.set("frame_orthonormality_error", q.orthonormality_error);
+  summary.set("frame_handedness_min", q.min_handedness);
+  summary.set("max_neighbour_fiber_angle", q.max_neighbour_fiber_angle_deg, "deg");
+  summary.set("max_neighbour_frame_angle", q.max_neighbour_frame_angle_deg, "deg");
+  summary.set("transmural_min", q.transmural_min);
+  summary.set("transmural_max", q.transmural_max);
+  summary.set("longitudinal_coordinate_min", q.longitudinal_min);
+  summary.set("longitudinal_coordinate_max", q.longitudinal_max);
+  summary.set("tangent_vs_grad_l_angle_max", q.tangent_blend_angle_max_deg, "deg");
+  summary.set("laplace_relative_residual", std::max(r.transmural_residual, r.longitudinal_residual));
+  summary.set("laplace_time", r.laplace_seconds, "s");
+  summary.note("fiber_method", fmt::format("harmonic lifting, centerline weight {}, linear solver {}", o.centerline_weight,
+                                           o.linear_solver));
+}
+
+}  // namespace stentsim::fibers

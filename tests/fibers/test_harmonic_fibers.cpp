@@ -1,0 +1,229 @@
+// Harmonic-lifting fibers (fibers/harmonic_fibers.*): against the analytic
+// tube fibers on straight tubes, orthonormal/right-handed/smooth frames on a
+// bent tube, boundary values and the discrete maximum principle of the
+// Laplace solutions, and errors on bad input.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "common/error.hpp"
+#include "common/mesh_tags.hpp"
+#include "fibers/analytic_tube_fibers.hpp"
+#include "fibers/harmonic_fibers.hpp"
+#include "solver/fem/boundary_faces.hpp"
+#include "solver/io/generated_meshes.hpp"
+
+using namespace stentsim;
+using Vec3 = Eigen::Vector3d;
+
+namespace {
+constexpr double kRi = 0.8, kRo = 1.4, kLength = 3.0;
+const double kPhiA = 40.0 * M_PI / 180.0;
+
+fibers::LayerAngles angles() { return {{tags::intima, 0.0}, {tags::media, 0.0}, {tags::adventitia, kPhiA}}; }
+
+/// A closed tube ring_sector -> tet4 (-> tet10) with Layer (inner half media,
+/// outer half adventitia) and boundary faces tagged by where they lie.
+MeshData tube(bool quadratic, int nr = 4, int nt = 64, int nz = 8) {
+  MeshData m = solver::hex8_to_tet4(solver::ring_sector_hex8(kRi, kRo, 2 * M_PI, kLength, nr, nt, nz));
+  if (quadratic) m = solver::tet4_to_tet10(m);
+  DataArray layer{1, {}}, group{1, {}};
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    Vec3 x = Vec3::Zero();
+    for (auto n : m.cell(c)) x += m.points[static_cast<std::size_t>(n)];
+    x /= static_cast<double>(m.cell(c).size());
+    layer.values.push_back(std::hypot(x.x(), x.y()) < 0.5 * (kRi + kRo) ? tags::media : tags::adventitia);
+    group.values.push_back(0);
+  }
+  const auto faces = solver::fem::boundary_faces(m);
+  for (const auto& f : faces) {
+    Vec3 x = Vec3::Zero();
+    std::vector<std::int64_t> nodes(f.nodes.begin(), f.nodes.begin() + f.count);
+    for (auto n : nodes) x += m.points[static_cast<std::size_t>(n)];
+    x /= f.count;
+    const double r = std::hypot(x.x(), x.y());
+    int g = x.z() < 1e-9 ? tags::proximal_cut : x.z() > kLength - 1e-9 ? tags::distal_cut
+            : r < 0.5 * (kRi + kRo) ? tags::endothelium : tags::outer_wall;
+    m.add_cell(f.type, nodes);
+    layer.values.push_back(0);
+    group.values.push_back(g);
+  }
+  m.cell_data[tags::kLayer] = layer;
+  m.cell_data[tags::kFaceGroup] = group;
+  return m;
+}
+
+MeshData line(const std::vector<Vec3>& pts) {
+  MeshData c;
+  c.points = pts;
+  std::vector<std::int64_t> ids(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) ids[i] = static_cast<std::int64_t>(i);
+  c.add_cell(CellType::polyline, ids);
+  return c;
+}
+
+MeshData straight_centerline(bool reversed = false) {
+  std::vector<Vec3> p;
+  for (int i = 0; i <= 30; ++i) p.push_back(Vec3(0, 0, -0.5 + (kLength + 1.0) * i / 30.0));
+  if (reversed) std::reverse(p.begin(), p.end());
+  return line(p);
+}
+
+Vec3 get(const MeshData& m, const char* name, std::size_t c) {
+  const auto& a = m.cell_data.at(name);
+  return {a.at(c, 0), a.at(c, 1), a.at(c, 2)};
+}
+double deg(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / M_PI; }
+
+struct AngleErrors {
+  double mean = 0, max = 0;
+};
+
+/// Angle errors of every frame vector and fiber against the analytic tube fibers.
+AngleErrors compare_with_analytic(const MeshData& mesh, const MeshData& h) {
+  const MeshData a = fibers::tube_fibers(mesh, angles());
+  EXPECT_EQ(a.num_cells(), h.num_cells());
+  AngleErrors e;
+  std::size_t n = 0;
+  for (std::size_t c = 0; c < a.num_cells(); ++c)
+    for (const char* name : {"Radial", "Circumferential", "Longitudinal", "Fiber1", "Fiber2"}) {
+      const double d = deg(get(a, name, c), get(h, name, c));
+      e.mean += d, e.max = std::max(e.max, d), ++n;
+    }
+  e.mean /= static_cast<double>(n);
+  return e;
+}
+
+void expect_boundary_values(const MeshData& mesh, const MeshData& h) {
+  const auto& t = h.point_data.at("Transmural");
+  const auto& l = h.point_data.at("LongitudinalCoordinate");
+  const auto& g = mesh.cell_data.at(tags::kFaceGroup);
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    const int grp = static_cast<int>(g.at(c));
+    for (auto n : mesh.cell(c)) {
+      const auto i = static_cast<std::size_t>(n);
+      if (grp == tags::endothelium) ASSERT_NEAR(t.at(i), 0.0, 1e-12);
+      if (grp == tags::outer_wall) ASSERT_NEAR(t.at(i), 1.0, 1e-12);
+      if (grp == tags::proximal_cut) ASSERT_NEAR(l.at(i), 0.0, 1e-12);
+      if (grp == tags::distal_cut) ASSERT_NEAR(l.at(i), 1.0, 1e-12);
+    }
+  }
+}
+}  // namespace
+
+TEST(HarmonicFibers, StraightTubeTet4MatchesAnalytic) {
+  const MeshData mesh = tube(false);
+  fibers::HarmonicFiberOptions o;
+  o.angles = angles();
+  o.linear_solver = "direct";
+  const auto r = fibers::harmonic_fibers(mesh, straight_centerline(), o);
+  const auto e = compare_with_analytic(mesh, r.fibers);
+  std::printf("tet4 tube: mean angle error %.4f deg, max %.4f deg, neighbour fiber angle max %.2f deg, t in [%.3g, %.3g]\n",
+              e.mean, e.max, r.quality.max_neighbour_fiber_angle_deg, r.quality.transmural_min, r.quality.transmural_max);
+  EXPECT_LT(e.mean, 0.5);
+  EXPECT_LT(e.max, 2.0);
+  expect_boundary_values(mesh, r.fibers);
+  // Discrete maximum principle (tet4): nodal t and l within their boundary values.
+  EXPECT_GE(r.quality.transmural_min, -1e-9);
+  EXPECT_LE(r.quality.transmural_max, 1 + 1e-9);
+  EXPECT_GE(r.quality.longitudinal_min, -1e-9);
+  EXPECT_LE(r.quality.longitudinal_max, 1 + 1e-9);
+  EXPECT_LT(r.transmural_residual, 1e-8);
+}
+
+TEST(HarmonicFibers, StraightTubeTet10MatchesAnalyticWithReversedCenterline) {
+  const MeshData mesh = tube(true, 3, 48, 6);
+  fibers::HarmonicFiberOptions o;
+  o.angles = angles();
+  o.linear_solver = "gmres_ilu";
+  // The centerline's direction must not matter: grad l orients it.
+  const auto r = fibers::harmonic_fibers(mesh, straight_centerline(true), o);
+  const auto e = compare_with_analytic(mesh, r.fibers);
+  std::printf("tet10 tube (%zu nodes): Laplace %.2f s, %d + %d iterations; mean angle error %.4f deg, max %.4f deg, "
+              "t in [%.4g, %.4g], l in [%.4g, %.4g]\n",
+              mesh.points.size(), r.laplace_seconds, r.transmural_iterations, r.longitudinal_iterations, e.mean,
+              e.max, r.quality.transmural_min, r.quality.transmural_max, r.quality.longitudinal_min,
+              r.quality.longitudinal_max);
+  EXPECT_LT(e.mean, 0.5);
+  EXPECT_LT(e.max, 2.0);
+  expect_boundary_values(mesh, r.fibers);
+  // tet10 has no discrete maximum principle in general; we check the nodal
+  // values overshoot their boundary values by at most 1 % of the range.
+  EXPECT_GE(r.quality.transmural_min, -0.01);
+  EXPECT_LE(r.quality.transmural_max, 1.01);
+  EXPECT_GE(r.quality.longitudinal_min, -0.01);
+  EXPECT_LE(r.quality.longitudinal_max, 1.01);
+  EXPECT_LT(r.quality.orthonormality_error, 1e-12);
+}
+
+/// The tube bent about a circle of radius R in the x-z plane (a quarter torus
+/// section): frames must stay orthonormal, right-handed, smooth and follow the bend.
+TEST(HarmonicFibers, BentTubeFramesAreOrthonormalRightHandedAndSmooth) {
+  MeshData mesh = tube(false, 4, 48, 16);
+  const double bend = 6.0;  // mm radius of curvature
+  auto map = [&](const Vec3& p) {
+    const double a = p.z() / bend;
+    const Vec3 c(bend * (1 - std::cos(a)), 0, bend * std::sin(a));
+    const Vec3 e1(std::cos(a), 0, -std::sin(a));
+    return Vec3(c + p.x() * e1 + p.y() * Vec3::UnitY());
+  };
+  for (auto& p : mesh.points) p = map(p);
+  std::vector<Vec3> cl;
+  for (int i = 0; i <= 40; ++i) cl.push_back(map(Vec3(0, 0, -0.3 + (kLength + 0.6) * i / 40.0)));
+  fibers::HarmonicFiberOptions o;
+  o.angles = angles();
+  o.linear_solver = "direct";
+  const auto r = fibers::harmonic_fibers(mesh, line(cl), o);
+  const auto& q = r.quality;
+  std::printf("bent tube: orthonormality %.2e, handedness min %.6f, neighbour fiber angle max %.2f deg, frame %.2f deg, "
+              "tangent vs grad l max %.2f deg\n",
+              q.orthonormality_error, q.min_handedness, q.max_neighbour_fiber_angle_deg, q.max_neighbour_frame_angle_deg,
+              q.tangent_blend_angle_max_deg);
+  EXPECT_LT(q.orthonormality_error, 1e-12);
+  EXPECT_NEAR(q.min_handedness, 1.0, 1e-12);
+  // 48 elements around: the analytic circumferential direction turns 7.5 deg
+  // between neighbours; a smooth field stays within twice that.
+  EXPECT_LT(q.max_neighbour_fiber_angle_deg, 15.0);
+  EXPECT_LT(q.max_neighbour_frame_angle_deg, 15.0);
+  // The longitudinal direction follows the centerline tangent of the bend.
+  double worst = 0;
+  const auto& f = r.fibers;
+  for (std::size_t c = 0; c < f.num_cells(); ++c) {
+    Vec3 x = Vec3::Zero();
+    for (auto n : f.cell(c)) x += f.points[static_cast<std::size_t>(n)];
+    x /= 4;
+    const double a = std::atan2(x.z(), bend - x.x());
+    worst = std::max(worst, deg(get(f, "Longitudinal", c), Vec3(std::sin(a), 0, std::cos(a))));
+  }
+  std::printf("bent tube: longitudinal vs bend tangent max %.2f deg\n", worst);
+  EXPECT_LT(worst, 10.0);
+  expect_boundary_values(mesh, r.fibers);
+  EXPECT_GE(q.transmural_min, -1e-9);
+  EXPECT_LE(q.transmural_max, 1 + 1e-9);
+}
+
+TEST(HarmonicFibers, BadInputIsAnError) {
+  fibers::HarmonicFiberOptions o;
+  o.angles = angles();
+  o.linear_solver = "direct";
+  const MeshData good = tube(false, 2, 16, 2);
+  MeshData no_groups = good;
+  no_groups.cell_data.erase(tags::kFaceGroup);
+  EXPECT_THROW(fibers::harmonic_fibers(no_groups, straight_centerline(), o), InputError);
+  MeshData no_distal = good;
+  for (auto& v : no_distal.cell_data.at(tags::kFaceGroup).values)
+    if (v == tags::distal_cut) v = tags::outer_wall;
+  EXPECT_THROW(fibers::harmonic_fibers(no_distal, straight_centerline(), o), InputError);
+  MeshData no_faces = solver::hex8_to_tet4(solver::ring_sector_hex8(kRi, kRo, 2 * M_PI, kLength, 2, 16, 2));
+  no_faces.cell_data[tags::kLayer] = {1, std::vector<double>(no_faces.num_cells(), tags::media)};
+  no_faces.cell_data[tags::kFaceGroup] = {1, std::vector<double>(no_faces.num_cells(), 0)};
+  EXPECT_THROW(fibers::harmonic_fibers(no_faces, straight_centerline(), o), InputError);
+  MeshData no_layer = good;
+  no_layer.cell_data.erase(tags::kLayer);
+  EXPECT_THROW(fibers::harmonic_fibers(no_layer, straight_centerline(), o), InputError);
+  fibers::HarmonicFiberOptions missing = o;
+  missing.angles.erase(tags::adventitia);
+  EXPECT_THROW(fibers::harmonic_fibers(good, straight_centerline(), missing), InputError);
+  EXPECT_THROW(fibers::harmonic_fibers(good, MeshData{}, o), InputError);
+}
