@@ -2,10 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "common/config.hpp"
 #include "common/mesh_tags.hpp"
 #include "device_gen/stages.hpp"
 #include "fibers/analytic_tube_fibers.hpp"
+#include "fibers/harmonic_fibers.hpp"
 #include "meshing/generic_artery.hpp"
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/segmentation_stage.hpp"
@@ -49,6 +52,24 @@ Stage tube_fibers_stage(const CaseConfig& c) {
   s.run = [angles](StageContext& ctx) {
     fibers::write_tube_fibers(ctx.input("mesh/artery.vtu").string(), angles, ctx.output("fibers/fibers.vtu").string(),
                               ctx.summary());
+  };
+  return s;
+}
+
+/// Patient wall: fibers by harmonic lifting on the meshed wall (fibers/harmonic_fibers.hpp).
+Stage harmonic_fibers_stage(const CaseConfig& c) {
+  Stage s;
+  s.name = "fibers";
+  s.inputs = {"mesh/artery.vtu", "centerline/centerline.vtp"};
+  s.outputs = {"fibers/fibers.vtu"};
+  s.config = slice(c, {"fibers"});
+  s.version = "1";
+  fibers::HarmonicFiberOptions o;
+  o.angles = {{tags::intima, c.fibers.intima_angle}, {tags::media, c.fibers.media_angle},
+              {tags::adventitia, c.fibers.adventitia_angle}};
+  s.run = [o](StageContext& ctx) {
+    fibers::write_harmonic_fibers(ctx.input("mesh/artery.vtu").string(), ctx.input("centerline/centerline.vtp").string(), o,
+                                  ctx.output("fibers/fibers.vtu").string(), ctx.summary());
   };
   return s;
 }
@@ -187,6 +208,11 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
       stages.push_back(device_stage(c, "stent"));
       break;
   }
+  // The patient's fibers need the wall mesh: added once a stage produces it.
+  const bool has_wall_mesh = std::any_of(stages.begin(), stages.end(), [](const Stage& s) {
+    return std::find(s.outputs.begin(), s.outputs.end(), "mesh/artery.vtu") != s.outputs.end();
+  });
+  if (c.scene == Scene::patient && has_wall_mesh) stages.push_back(harmonic_fibers_stage(c));
   return stages;
 }
 

@@ -3,9 +3,11 @@
 // bent tube, boundary values and the discrete maximum principle of the
 // Laplace solutions, and errors on bad input.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <filesystem>
 
 #include "common/error.hpp"
 #include "common/mesh_tags.hpp"
@@ -13,6 +15,7 @@
 #include "fibers/harmonic_fibers.hpp"
 #include "solver/fem/boundary_faces.hpp"
 #include "solver/io/generated_meshes.hpp"
+#include "tests/workflows/cli_runner.hpp"
 
 using namespace stentsim;
 using Vec3 = Eigen::Vector3d;
@@ -110,6 +113,7 @@ void expect_boundary_values(const MeshData& mesh, const MeshData& h) {
     }
   }
 }
+std::string fmt_dir() { return "stentsim_fibers_cli_" + std::to_string(::getpid()); }
 }  // namespace
 
 TEST(HarmonicFibers, StraightTubeTet4MatchesAnalytic) {
@@ -226,4 +230,34 @@ TEST(HarmonicFibers, BadInputIsAnError) {
   missing.angles.erase(tags::adventitia);
   EXPECT_THROW(fibers::harmonic_fibers(good, straight_centerline(), missing), InputError);
   EXPECT_THROW(fibers::harmonic_fibers(good, MeshData{}, o), InputError);
+}
+
+TEST(HarmonicFibers, CliWritesFibersAndSummaryAndRejectsMeshWithoutFaceGroups) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / fmt_dir();
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const MeshData mesh = tube(true, 2, 32, 4);
+  write_vtu((dir / "artery.vtu").string(), mesh);
+  write_vtp((dir / "centerline.vtp").string(), straight_centerline());
+  const auto r = stentsim::testing::run_stentsim("fibers --mesh " + (dir / "artery.vtu").string() + " --centerline " +
+                                       (dir / "centerline.vtp").string() + " --out " + (dir / "out/fibers.vtu").string() +
+                                       " --adventitia-angle 40 --linear-solver direct");
+  ASSERT_EQ(r.code, 0) << r.out;
+  ASSERT_TRUE(fs::exists(dir / "out/summary.yaml"));
+  const MeshData f = read_vtu((dir / "out/fibers.vtu").string());
+  const auto e = compare_with_analytic(mesh, f);
+  EXPECT_LT(e.mean, 0.5);
+  EXPECT_TRUE(f.point_data.count("Transmural"));
+  EXPECT_TRUE(f.cell_data.count("Transmural"));
+
+  MeshData bad = mesh;
+  bad.cell_data.erase(tags::kFaceGroup);
+  write_vtu((dir / "bad.vtu").string(), bad);
+  const auto b = stentsim::testing::run_stentsim("fibers --mesh " + (dir / "bad.vtu").string() + " --centerline " +
+                                       (dir / "centerline.vtp").string() + " --out " + (dir / "bad/fibers.vtu").string());
+  EXPECT_NE(b.code, 0);
+  EXPECT_NE(b.out.find("FaceGroup"), std::string::npos) << b.out;
+  EXPECT_FALSE(fs::exists(dir / "bad/fibers.vtu"));
+  fs::remove_all(dir);
 }
