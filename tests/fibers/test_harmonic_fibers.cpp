@@ -13,7 +13,7 @@
 #include "common/mesh_tags.hpp"
 #include "fibers/analytic_tube_fibers.hpp"
 #include "fibers/harmonic_fibers.hpp"
-#include "solver/fem/boundary_faces.hpp"
+#include "fibers/tagged_tube.hpp"
 #include "solver/io/generated_meshes.hpp"
 #include "tests/workflows/cli_runner.hpp"
 
@@ -26,35 +26,12 @@ const double kPhiA = 40.0 * M_PI / 180.0;
 
 fibers::LayerAngles angles() { return {{tags::intima, 0.0}, {tags::media, 0.0}, {tags::adventitia, kPhiA}}; }
 
-/// A closed tube ring_sector -> tet4 (-> tet10) with Layer (inner half media,
-/// outer half adventitia) and boundary faces tagged by where they lie.
+/// The straight tagged tube (tet4 or tet10) of the fiber tests.
 MeshData tube(bool quadratic, int nr = 4, int nt = 64, int nz = 8) {
-  MeshData m = solver::hex8_to_tet4(solver::ring_sector_hex8(kRi, kRo, 2 * M_PI, kLength, nr, nt, nz));
-  if (quadratic) m = solver::tet4_to_tet10(m);
-  DataArray layer{1, {}}, group{1, {}};
-  for (std::size_t c = 0; c < m.num_cells(); ++c) {
-    Vec3 x = Vec3::Zero();
-    for (auto n : m.cell(c)) x += m.points[static_cast<std::size_t>(n)];
-    x /= static_cast<double>(m.cell(c).size());
-    layer.values.push_back(std::hypot(x.x(), x.y()) < 0.5 * (kRi + kRo) ? tags::media : tags::adventitia);
-    group.values.push_back(0);
-  }
-  const auto faces = solver::fem::boundary_faces(m);
-  for (const auto& f : faces) {
-    Vec3 x = Vec3::Zero();
-    std::vector<std::int64_t> nodes(f.nodes.begin(), f.nodes.begin() + f.count);
-    for (auto n : nodes) x += m.points[static_cast<std::size_t>(n)];
-    x /= f.count;
-    const double r = std::hypot(x.x(), x.y());
-    int g = x.z() < 1e-9 ? tags::proximal_cut : x.z() > kLength - 1e-9 ? tags::distal_cut
-            : r < 0.5 * (kRi + kRo) ? tags::endothelium : tags::outer_wall;
-    m.add_cell(f.type, nodes);
-    layer.values.push_back(0);
-    group.values.push_back(g);
-  }
-  m.cell_data[tags::kLayer] = layer;
-  m.cell_data[tags::kFaceGroup] = group;
-  return m;
+  fibers::TaggedTubeSpec s;
+  s.inner_radius = kRi, s.outer_radius = kRo, s.length = kLength;
+  s.elements_radial = nr, s.elements_around = nt, s.elements_along = nz, s.quadratic = quadratic;
+  return fibers::tagged_tube(s);
 }
 
 MeshData line(const std::vector<Vec3>& pts) {
@@ -164,21 +141,15 @@ TEST(HarmonicFibers, StraightTubeTet10MatchesAnalyticWithReversedCenterline) {
 /// The tube bent about a circle of radius R in the x-z plane (a quarter torus
 /// section): frames must stay orthonormal, right-handed, smooth and follow the bend.
 TEST(HarmonicFibers, BentTubeFramesAreOrthonormalRightHandedAndSmooth) {
-  MeshData mesh = tube(false, 4, 48, 16);
   const double bend = 6.0;  // mm radius of curvature
-  auto map = [&](const Vec3& p) {
-    const double a = p.z() / bend;
-    const Vec3 c(bend * (1 - std::cos(a)), 0, bend * std::sin(a));
-    const Vec3 e1(std::cos(a), 0, -std::sin(a));
-    return Vec3(c + p.x() * e1 + p.y() * Vec3::UnitY());
-  };
-  for (auto& p : mesh.points) p = map(p);
-  std::vector<Vec3> cl;
-  for (int i = 0; i <= 40; ++i) cl.push_back(map(Vec3(0, 0, -0.3 + (kLength + 0.6) * i / 40.0)));
+  fibers::TaggedTubeSpec spec;
+  spec.inner_radius = kRi, spec.outer_radius = kRo, spec.length = kLength;
+  spec.elements_radial = 4, spec.elements_around = 48, spec.elements_along = 16, spec.bend_radius = bend;
+  const MeshData mesh = fibers::tagged_tube(spec);
   fibers::HarmonicFiberOptions o;
   o.angles = angles();
   o.linear_solver = "direct";
-  const auto r = fibers::harmonic_fibers(mesh, line(cl), o);
+  const auto r = fibers::harmonic_fibers(mesh, fibers::tagged_tube_axis(spec, 0.3, 40), o);
   const auto& q = r.quality;
   std::printf("bent tube: orthonormality %.2e, handedness min %.6f, neighbour fiber angle max %.2f deg, frame %.2f deg, "
               "tangent vs grad l max %.2f deg\n",

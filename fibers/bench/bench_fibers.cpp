@@ -1,0 +1,51 @@
+// Benchmark of the harmonic-lifting fiber stage (not a test): a tagged tet10
+// tube of about the size of the paper's Case 2 wall (238,123 nodes), the two
+// Laplace solves and the frame construction, median of several runs per
+// linear solver. Usage: bench_fibers [runs=3] [elements_around=96] [elements_along=63]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "common/mesh_tags.hpp"
+#include "fibers/harmonic_fibers.hpp"
+#include "fibers/tagged_tube.hpp"
+
+using namespace stentsim;
+
+int main(int argc, char** argv) {
+  const int runs = argc > 1 ? std::atoi(argv[1]) : 3;
+  fibers::TaggedTubeSpec s;
+  s.inner_radius = 0.95, s.outer_radius = 1.55, s.length = 21.0;  // Case 2: 21 mm segment
+  s.elements_radial = 4;
+  s.elements_around = argc > 2 ? std::atoi(argv[2]) : 96;
+  s.elements_along = argc > 3 ? std::atoi(argv[3]) : 63;
+  s.quadratic = true;
+  const MeshData mesh = fibers::tagged_tube(s);
+  const MeshData axis = fibers::tagged_tube_axis(s);
+  std::size_t cells = 0;
+  for (auto t : mesh.cell_types) cells += t == CellType::quadratic_tetra;
+  std::printf("tet10 tube: %zu nodes, %zu tet10\n", mesh.points.size(), cells);
+  fibers::HarmonicFiberOptions o;
+  o.angles = {{tags::media, 0.0}, {tags::adventitia, 40.0 * M_PI / 180}};
+  for (const char* solver : {"gmres_ilu", "direct"}) {
+    o.linear_solver = solver;
+    std::vector<double> total, laplace;
+    for (int r = 0; r < runs; ++r) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto res = fibers::harmonic_fibers(mesh, axis, o);
+      total.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      laplace.push_back(res.laplace_seconds);
+      if (r == 0)
+        std::printf("%s: iterations %d + %d, residual %.2e/%.2e, neighbour fiber angle max %.2f deg\n", solver,
+                    res.transmural_iterations, res.longitudinal_iterations, res.transmural_residual,
+                    res.longitudinal_residual, res.quality.max_neighbour_fiber_angle_deg);
+    }
+    std::sort(total.begin(), total.end());
+    std::sort(laplace.begin(), laplace.end());
+    std::printf("%s: median total %.2f s (Laplace solves %.2f s) over %d runs\n", solver, total[total.size() / 2],
+                laplace[laplace.size() / 2], runs);
+  }
+  return 0;
+}
