@@ -108,7 +108,8 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     res.residual_norms.push_back(r_norm);
     const double du_norm = step.norm();
     const bool r_ok = r_norm <= settings.residual_tolerance * scale + settings.residual_absolute;
-    const bool du_ok = du_norm <= settings.increment_tolerance * std::max(u.norm(), 1e-12) || r_norm == 0.0;
+    const bool du_ok = du_norm <= settings.increment_tolerance * std::max(u.norm(), 1e-12) ||
+                       du_norm <= settings.increment_absolute || r_norm == 0.0;
     log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}", it, r_norm,
                scale, du_norm, best_alpha, ls.iterations);
     // Round-off floor: an increment at machine precision cannot improve the state
