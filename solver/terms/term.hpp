@@ -15,6 +15,8 @@
 //   its partition (state.rank, state.ranks) and the assembler sums them.
 #include <Eigen/Core>
 
+#include "solver/terms/history_archive.hpp"
+
 #include <span>
 #include <string>
 
@@ -67,6 +69,18 @@ class Term {
   virtual void commit() {}
   /// The load step is cut: go back to the last committed state.
   virtual void rollback() {}
+
+  /// Restart (issue 6): write the committed history (the state after the last
+  /// commit(): multiplicative DOFs, per-Gauss-point internal variables) into
+  /// `out` under keys beginning with `prefix`, one flat array per field
+  /// (history_archive.hpp gives the layout). A term whose state is fully in
+  /// the global vector u writes nothing. `has_history()` must be true when the
+  /// term keeps state between steps, so a solver can refuse to checkpoint a
+  /// term that cannot save it.
+  virtual bool has_history() const { return false; }
+  virtual void save_history(HistoryArchive& out, const std::string& prefix) const {}
+  /// Restores what save_history wrote; trial and accepted states become the committed one.
+  virtual void load_history(const HistoryArchive& in, const std::string& prefix) {}
 };
 
 }  // namespace stentsim::solver
