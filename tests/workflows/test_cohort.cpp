@@ -11,6 +11,7 @@
 
 #include "common/files.hpp"
 #include "tests/workflows/cli_runner.hpp"
+#include "workflows/cohort/cohort_plots.hpp"
 #include "workflows/cohort/cohort_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -85,6 +86,16 @@ TEST_F(Cohort, UnexpectedOutcomeExitsOne) {
   EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.csv").find("\"odd\",\"succeeded unexpectedly\""), std::string::npos);
 }
 
+TEST_F(Cohort, ExpectedFailureStageNotRunIsDone) {
+  // --until stops before the stage meant to fail: nothing unexpected happened.
+  const auto f = cohort("  - id: odd\n    expect_failure: fibers\n");
+  auto r = sh("cohort run " + f + " --until mesh");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.csv").find("\"odd\",\"done\""), std::string::npos);
+  r = sh("cohort run " + f);  // now fibers runs and succeeds
+  EXPECT_EQ(r.code, 1) << r.out;
+}
+
 TEST_F(Cohort, BadCohortFilesStopBeforeAnythingRuns) {
   auto r = sh("cohort run " + cohort("  - id: a\n  - id: a\n"));
   EXPECT_EQ(r.code, 2);
@@ -116,6 +127,40 @@ TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   EXPECT_NE(csv.find("\"severe\",\"failed as expected\",\"placement\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("\"rca-seed1\",\"done\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("placement.placement_min_clearance [mm]"), std::string::npos) << csv;
+  // A PNG per numeric QoI beside the CSV, and the Markdown summary.
+  const auto png = read_text(dir / "cohort.work/plot_centerline.stenosis_percent_diameter.png");
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_GT(png.size(), 5000u);
+  EXPECT_TRUE(fs::exists(dir / "cohort.work/plot_placement.placement_min_clearance.png"));
+  const auto md = read_text(dir / "cohort.work/cohort_summary.md");
+  EXPECT_NE(md.find("| severe | failed as expected | placement |"), std::string::npos) << md;
+  EXPECT_NE(md.find("[plot_centerline.stenosis_percent_diameter.png]"), std::string::npos) << md;
+  fs::remove_all(dir);
+}
+
+TEST(CohortPlots, OnlyNumericQoisAndFailedCasesMarked) {
+  using namespace stentsim::workflows;
+  const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-plots-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  CohortConfig c;
+  c.name = "t";
+  c.work_dir = dir;
+  CohortTable t;
+  t.columns = {"case", "status", "failed_stage", "message", "wall_time_s", "mesh.size [mm]", "segmentation.input"};
+  t.rows = {{{"case", "a"}, {"status", "done"}, {"mesh.size [mm]", "0.5"}, {"segmentation.input", "phantom"}},
+            {{"case", "b"}, {"status", "failed"}, {"failed_stage", "mesh"}, {"message", "boom | x"}},
+            {{"case", "c"}, {"status", "failed as expected"}, {"mesh.size [mm]", "0.7"}}};
+  EXPECT_EQ(numeric_qoi_columns(t), std::vector<std::string>{"mesh.size [mm]"});
+  const auto written = write_cohort_plots(c, t);
+  ASSERT_EQ(written.size(), 1u);
+  EXPECT_EQ(written[0].filename(), "plot_mesh.size.png");
+  EXPECT_GT(fs::file_size(written[0]), 5000u);
+  write_cohort_markdown(c, t);
+  const auto md = read_text(dir / "cohort_summary.md");
+  EXPECT_NE(md.find("| b | failed | mesh |"), std::string::npos) << md;
+  EXPECT_NE(md.find("boom \\| x"), std::string::npos) << md;  // '|' escaped in the table
+  EXPECT_NE(md.find("| mesh.size | mm | 2 | 0.5 | 0.6 | 0.7 |"), std::string::npos) << md;
   fs::remove_all(dir);
 }
 

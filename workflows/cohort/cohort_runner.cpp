@@ -20,6 +20,7 @@
 #include "common/summary.hpp"
 #include "pipeline/manifest.hpp"
 #include "workflows/case_stages.hpp"
+#include "workflows/cohort/cohort_plots.hpp"
 
 namespace fs = std::filesystem;
 
@@ -46,6 +47,13 @@ std::string failed_stage_of(const fs::path& manifest_file) {
   for (const auto& name : all_stage_names())
     if (auto* r = m.find(name); r && r->status != "ok") return name;
   return "";
+}
+
+bool stage_succeeded(const fs::path& manifest_file, const std::string& stage) {
+  if (!fs::exists(manifest_file)) return false;
+  const auto m = pipeline::Manifest::load(manifest_file);
+  const auto* rec = m.find(stage);
+  return rec && rec->status == "ok";
 }
 
 pid_t start_case(const std::string& binary, const fs::path& case_file, const std::vector<std::string>& args, const fs::path& log) {
@@ -139,7 +147,9 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
     r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     r.failed_stage = r.exit_code ? failed_stage_of(dir / "work" / "manifest.yaml") : "";
-    if (r.exit_code == 0) r.status = k.expect_failure ? "succeeded unexpectedly" : "done";
+    if (r.exit_code == 0)
+      // With --until/--only the stage meant to fail may not have run: then "done".
+      r.status = k.expect_failure && stage_succeeded(dir / "work" / "manifest.yaml", *k.expect_failure) ? "succeeded unexpectedly" : "done";
     else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
     else r.status = r.exit_code == 130 ? "interrupted" : "failed";
     if (r.exit_code) r.message = tail_lines(dir / "run.log", 3);
@@ -171,9 +181,9 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
   return rep;
 }
 
-void write_cohort_summary(const CohortConfig& c, const CohortReport& r) {
+CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
   // Columns: fixed ones, then "<stage>.<qoi>" for every QoI any case has.
-  std::vector<std::map<std::string, std::string>> rows;
+  CohortTable t;
   std::set<std::string> columns;
   for (const auto& o : r.cases) {
     std::map<std::string, std::string> row = {{"case", o.id}, {"status", o.status}, {"failed_stage", o.failed_stage},
@@ -185,7 +195,7 @@ void write_cohort_summary(const CohortConfig& c, const CohortReport& r) {
       for (const auto& [name, q] : s.qois()) {
         std::string v;
         if (auto d = std::get_if<double>(&q.value)) v = fmt::format("{:.12g}", *d);
-        else if (auto t = std::get_if<std::string>(&q.value)) v = *t;
+        else if (auto txt = std::get_if<std::string>(&q.value)) v = *txt;
         else continue;  // vectors do not fit a CSV cell
         const std::string col = stage + "." + name + (q.unit.empty() ? "" : " [" + q.unit + "]");
         row[col] = v;
@@ -194,26 +204,33 @@ void write_cohort_summary(const CohortConfig& c, const CohortReport& r) {
       row[stage + ".wall_time_s"] = fmt::format("{:.3f}", s.wall_time_s());
       columns.insert(stage + ".wall_time_s");
     }
-    rows.push_back(std::move(row));
+    t.rows.push_back(std::move(row));
   }
+  t.columns = {"case", "status", "failed_stage", "message", "wall_time_s"};
+  t.columns.insert(t.columns.end(), columns.begin(), columns.end());
+  return t;
+}
+
+void write_cohort_summary(const CohortConfig& c, const CohortReport& r) {
+  const CohortTable t = cohort_table(c, r);
   auto quote = [](const std::string& s) {
     std::string q = "\"";
     for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
     return q + "\"";
   };
-  std::vector<std::string> header = {"case", "status", "failed_stage", "message", "wall_time_s"};
-  header.insert(header.end(), columns.begin(), columns.end());
   std::string text;
-  for (std::size_t i = 0; i < header.size(); ++i) text += (i ? "," : "") + quote(header[i]);
+  for (std::size_t i = 0; i < t.columns.size(); ++i) text += (i ? "," : "") + quote(t.columns[i]);
   text += "\n";
-  for (const auto& row : rows) {
-    for (std::size_t i = 0; i < header.size(); ++i) {
-      auto it = row.find(header[i]);
+  for (const auto& row : t.rows) {
+    for (std::size_t i = 0; i < t.columns.size(); ++i) {
+      auto it = row.find(t.columns[i]);
       text += (i ? "," : "") + quote(it == row.end() ? "" : it->second);
     }
     text += "\n";
   }
   files::write_atomic(c.work_dir / "cohort_summary.csv", text);
+  write_cohort_markdown(c, t);
+  write_cohort_plots(c, t);
 }
 
 }  // namespace stentsim::workflows

@@ -3,6 +3,7 @@
 // pool of local worker processes (each `stentsim run` of one case), records
 // each case's outcome and writes cohort_summary.csv.
 #include <iosfwd>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,8 +40,17 @@ int concurrent_cases(int workers, int ranks_per_case, int cores);
 
 CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out);
 
-/// Writes <work_dir>/cohort_summary.csv: one row per case with status,
-/// failed stage, message and every QoI of its stages' summary.yaml files.
+/// The cohort summary as a table: fixed columns (case, status, failed_stage,
+/// message, wall_time_s), then "<stage>.<qoi> [unit]" for every QoI any case's
+/// stage summaries hold, and "<stage>.wall_time_s"; one row per case.
+struct CohortTable {
+  std::vector<std::string> columns;
+  std::vector<std::map<std::string, std::string>> rows;  // column -> cell
+};
+CohortTable cohort_table(const CohortConfig& c, const CohortReport& r);
+
+/// Writes <work_dir>/cohort_summary.csv (the table above), then
+/// cohort_summary.md and one PNG per numeric QoI beside it (cohort_plots.hpp).
 void write_cohort_summary(const CohortConfig& c, const CohortReport& r);
 
 }  // namespace stentsim::workflows
