@@ -1,11 +1,13 @@
 // Benchmark of the harmonic-lifting fiber stage (not a test): a tagged tet10
 // tube of about the size of the paper's Case 2 wall (238,123 nodes), the two
 // Laplace solves and the frame construction, median of several runs per
-// linear solver. Usage: bench_fibers [runs=3] [elements_around=96] [elements_along=63]
+// linear solver. Usage: bench_fibers [runs=3] [elements_around=96] [elements_along=63] [solvers=gmres_ilu]
+// (solvers: comma-separated solver/linalg types; "direct" KLU2 takes minutes at this size).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "common/mesh_tags.hpp"
@@ -15,6 +17,7 @@
 using namespace stentsim;
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const int runs = argc > 1 ? std::atoi(argv[1]) : 3;
   fibers::TaggedTubeSpec s;
   s.inner_radius = 0.95, s.outer_radius = 1.55, s.length = 21.0;  // Case 2: 21 mm segment
@@ -29,7 +32,17 @@ int main(int argc, char** argv) {
   std::printf("tet10 tube: %zu nodes, %zu tet10\n", mesh.points.size(), cells);
   fibers::HarmonicFiberOptions o;
   o.angles = {{tags::media, 0.0}, {tags::adventitia, 40.0 * M_PI / 180}};
-  for (const char* solver : {"gmres_ilu", "direct"}) {
+  std::vector<std::string> solvers;
+  {
+    std::string list = argc > 4 ? argv[4] : "gmres_ilu";
+    for (std::size_t p = 0; p != std::string::npos;) {
+      const std::size_t q = list.find(',', p);
+      solvers.push_back(list.substr(p, q == std::string::npos ? q : q - p));
+      p = q == std::string::npos ? q : q + 1;
+    }
+  }
+  for (const auto& name : solvers) {
+    const char* solver = name.c_str();
     o.linear_solver = solver;
     std::vector<double> total, laplace;
     for (int r = 0; r < runs; ++r) {
