@@ -327,17 +327,47 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
     for (const auto& [name, beam] : built->beams) meshes.emplace_back(name, beams::beam_output_mesh(*beam, u));
     writer.write_frame(writer.frames(), t, meshes);
   };
-  frame(scene.stepping.t_start);
-  std::vector<std::string> columns{"step", "time", "dt", "load_factor", "newton_iterations", "linear_iterations", "step_cuts",
-                                   "wall_time_s", "assembly_s", "linear_solve_s"};
-  for (const auto& [name, p] : built->pressures) columns.push_back("pressure_" + name);
-  writer.history_header(columns);
-
+  const std::filesystem::path checkpoint_file = out_dir / "checkpoint.bin";
+  if (scene.checkpoint_every > 0)
+    for (const auto& b : scene.bodies)
+      for (const auto& [tag, mat] : b.materials)
+        if (mat.viscous)  // SolidBody does not save its viscous history yet
+          throw InputError(fmt::format("{}: output.checkpoint_every: body '{}' has a viscous material, whose history "
+                                       "checkpoints do not hold yet; remove checkpoint_every", scene_yaml.string(), b.name));
   Summary summary;
   std::map<std::string, std::vector<double>> qoi;
   long newton_total = 0, linear_total = 0, cuts_total = 0;
   int steps = 0;
   double t_last = scene.stepping.t_start;
+  if (options.restart) {
+    const std::filesystem::path from = options.restart->empty() ? checkpoint_file : *options.restart;
+    const HistoryArchive ck = HistoryArchive::read(from);
+    u = Eigen::Map<const Eigen::VectorXd>(ck.get("solver/u", model.dofs.size()).data(), model.dofs.size());
+    model.load_history(ck);
+    writer.load(ck);
+    for (const auto& q : scene.qois)
+      if (ck.has("qoi/" + q.name)) qoi[q.name] = ck.get("qoi/" + q.name);
+    for (const auto& q : scene.qois)
+      if (ck.has("tip_rotation/" + q.name)) {
+        const auto& v = ck.get("tip_rotation/" + q.name, 3);
+        built->tip_rotation[q.name] = Eigen::Vector3d(v[0], v[1], v[2]);
+      }
+    const auto& c = ck.get("solver/counters", 4);
+    newton_total = static_cast<long>(c[0]), linear_total = static_cast<long>(c[1]), cuts_total = static_cast<long>(c[2]);
+    steps = static_cast<int>(c[3]);
+    t_last = ck.get_scalar("solver/time");
+    scene.stepping.t_start = t_last;
+    scene.stepping.dt_initial = ck.get_scalar("solver/next_dt");
+    scene.stepping.first_step = steps;
+    log::info("restart from {}: step {}, t = {:.6g}, next dt = {:.3g}", from.string(), steps, t_last,
+              scene.stepping.dt_initial);
+  } else {
+    frame(scene.stepping.t_start);
+  }
+  std::vector<std::string> columns{"step", "time", "dt", "load_factor", "newton_iterations", "linear_iterations", "step_cuts",
+                                   "wall_time_s", "assembly_s", "linear_solve_s"};
+  for (const auto& [name, p] : built->pressures) columns.push_back("pressure_" + name);
+  if (!options.restart) writer.history_header(columns);
   const LoadCurve* lf = scene.load_factor_curve.empty() ? nullptr : &scene.curves.at(scene.load_factor_curve);
   auto on_step = [&](const StepRecord& r) {
     ++steps;
@@ -357,6 +387,20 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
     track_tip_rotations(scene, *built);
     for (const auto& q : scene.qois)
       if (std::abs(r.time - q.time) < tol) qoi[q.name] = qoi_values(q, *built, u);
+    if (scene.checkpoint_every > 0 && r.step % scene.checkpoint_every == 0 && writes) {
+      HistoryArchive ck;
+      ck.put("solver/u", std::span<const double>(u.data(), static_cast<std::size_t>(u.size())));
+      ck.put("solver/time", r.time);
+      ck.put("solver/next_dt", r.next_dt);
+      ck.put("solver/counters", std::vector<double>{static_cast<double>(newton_total), static_cast<double>(linear_total),
+                                                    static_cast<double>(cuts_total), static_cast<double>(steps)});
+      for (const auto& [name, v] : qoi) ck.put("qoi/" + name, v);
+      for (const auto& [name, v] : built->tip_rotation) ck.put("tip_rotation/" + name, std::span<const double>(v.data(), 3));
+      model.save_history(ck);
+      writer.save(ck);
+      ck.write(checkpoint_file);
+      log::info("checkpoint at step {} (t = {:.6g}): {}", r.step, r.time, checkpoint_file.string());
+    }
   };
   GlobalSystem system(model.constraints);
   int status = 0;

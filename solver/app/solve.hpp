@@ -3,6 +3,9 @@
 // runs the adaptive load stepping and writes, into the output folder,
 // results/*.vtu + results.pvd (TimeValue; first frame = initial state),
 // history.csv and summary.yaml (the scene's QoIs, e.g. inner_radius_at_pmax).
+// With output.checkpoint_every = N it writes checkpoint.bin (u, every term's
+// committed history, the stepper's next step size, outputs so far) every N
+// steps; a restart from it continues exactly as the uninterrupted run.
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -16,6 +19,9 @@ struct SolveOptions {
   std::optional<std::string> linear_solver;
   /// Log Newton iterations (debug level) when true.
   bool verbose = false;
+  /// Resume from a checkpoint (output.checkpoint_every); an empty path means
+  /// <output folder>/checkpoint.bin. The scene must be the one that wrote it.
+  std::optional<std::filesystem::path> restart;
 };
 
 /// Runs the scene. Returns 0 on success. On a computation that cannot

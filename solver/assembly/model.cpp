@@ -38,4 +38,16 @@ Eigen::MatrixXd Model::rigid_body_modes(const std::vector<std::pair<GlobalDof, V
   return m;
 }
 
+namespace {
+std::string term_prefix(std::size_t i, const Term& t) { return "term/" + std::to_string(i) + ":" + t.name() + "/"; }
+}  // namespace
+
+void Model::save_history(HistoryArchive& out) const {
+  for (std::size_t i = 0; i < terms.size(); ++i) terms[i]->save_history(out, term_prefix(i, *terms[i]));
+}
+
+void Model::load_history(const HistoryArchive& in) {
+  for (std::size_t i = 0; i < terms.size(); ++i) terms[i]->load_history(in, term_prefix(i, *terms[i]));
+}
+
 }  // namespace stentsim::solver

@@ -36,6 +36,9 @@ class Model {
   void accept() { for (auto& t : terms) t->accept(); }
   void commit() { for (auto& t : terms) t->commit(); }
   void rollback() { for (auto& t : terms) t->rollback(); }
+  /// Restart: every term's committed history under "term/<index>:<name>/".
+  void save_history(HistoryArchive& out) const;
+  void load_history(const HistoryArchive& in);
 
   /// Rigid-body modes of the 3-DOF-per-node part (n x 6) from reference positions, for AMG.
   Eigen::MatrixXd rigid_body_modes(const std::vector<std::pair<GlobalDof, Vec3>>& nodes) const;

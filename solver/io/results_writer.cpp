@@ -35,4 +35,19 @@ void ResultsWriter::history_row(const std::vector<double>& values) {
   files::write_atomic(dir_ / "history.csv", history_);
 }
 
+void ResultsWriter::save(HistoryArchive& out) const {
+  out.put_text("results/pvd", pvd_body_);
+  out.put_text("results/history", history_);
+  out.put("results/frames", static_cast<double>(frames_));
+  out.put("results/last_time", last_time_);
+}
+
+void ResultsWriter::load(const HistoryArchive& in) {
+  pvd_body_ = in.get_text("results/pvd");
+  history_ = in.get_text("results/history");
+  frames_ = static_cast<int>(in.get_scalar("results/frames"));
+  last_time_ = in.get_scalar("results/last_time");
+  files::write_atomic(dir_ / "history.csv", history_);
+}
+
 }  // namespace stentsim::solver

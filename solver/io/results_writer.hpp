@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/mesh_data.hpp"
+#include "solver/terms/history_archive.hpp"
 
 namespace stentsim::solver {
 
@@ -19,6 +20,9 @@ class ResultsWriter {
   void history_header(const std::vector<std::string>& columns);
   void history_row(const std::vector<double>& values);
   int frames() const { return frames_; }
+  /// Restart: what has been written so far (PVD entries, history rows, frame count, last time).
+  void save(HistoryArchive& out) const;
+  void load(const HistoryArchive& in);
   double last_time() const { return last_time_; }
 
  private:

@@ -342,6 +342,7 @@ SceneDesc read_scene(const std::filesystem::path& file) {
 
   ConfigMap out = root.map("output");
   scene.output_every = out.integer("every", 1, Range::between(1, 1000000));
+  scene.checkpoint_every = out.integer("checkpoint_every", 0, Range::between(0, 1000000));
   scene.load_factor_curve = out.string("load_factor_curve", scene.curves.empty() ? "" : scene.curves.begin()->first);
   if (!scene.load_factor_curve.empty() && !scene.curves.count(scene.load_factor_curve))
     out.fail("load_factor_curve", fmt::format("no load curve named '{}'", scene.load_factor_curve));

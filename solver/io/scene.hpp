@@ -78,6 +78,7 @@ struct SceneDesc {
   NewtonSettings newton;
   LinearSolverSettings linear;
   int output_every = 1;                     // VTU every N steps (and at every stop)
+  int checkpoint_every = 0;                 // checkpoint.bin every N steps (0: none); `solve --restart` resumes
   std::vector<QoiDesc> qois;
 };
 

@@ -18,7 +18,7 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
   std::sort(stops.begin(), stops.end());
   const double eps = 1e-12 * std::max(1.0, std::abs(s.t_end));
   double t = s.t_start, dt = std::min(s.dt_initial, s.dt_max);
-  int step = 0;
+  int step = s.first_step;
   const auto run_start = std::chrono::steady_clock::now();
   while (t < s.t_end - eps) {
     const double next_stop = *std::upper_bound(stops.begin(), stops.end(), t + eps);
@@ -53,6 +53,7 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
     rec.step = ++step;
     rec.time = t;
     rec.cuts = cuts;
+    rec.next_dt = dt;
     rec.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
     const double eta = t > s.t_start ? elapsed * (s.t_end - t) / (t - s.t_start) : 0.0;

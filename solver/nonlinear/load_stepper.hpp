@@ -22,6 +22,7 @@ struct StepperSettings {
   double cut_factor = 0.5, grow_factor = 1.5;
   int easy_iterations = 5;     // grow after a step with at most this many Newton iterations
   std::vector<double> stops;   // times a step must end on
+  int first_step = 0;          // steps done before t_start (restart: numbering continues)
 };
 
 struct StepRecord {
@@ -29,6 +30,7 @@ struct StepRecord {
   double time = 0.0, dt = 0.0;
   int newton_iterations = 0, linear_iterations = 0, cuts = 0;
   double wall_seconds = 0.0, assembly_seconds = 0.0, linear_seconds = 0.0;
+  double next_dt = 0.0;        // the step size the stepper tries next (restart resumes with it)
   std::vector<double> residual_norms;
 };
 

@@ -7,7 +7,7 @@ namespace stentsim::cli {
 
 void register_solve(CLI::App& app) {
   struct Args {
-    std::string scene, out, linear;
+    std::string scene, out, linear, restart;
     bool verbose = false;
   };
   auto a = std::make_shared<Args>();
@@ -17,11 +17,15 @@ void register_solve(CLI::App& app) {
   sub->add_option("--linear-solver", a->linear, "Override the scene's linear solver")
       ->check(CLI::IsMember({"direct", "gmres_ilu", "gmres_amg", "eigen_lu"}));
   sub->add_flag("--verbose,-v", a->verbose, "Log every Newton iteration");
-  on(sub, [a] {
+  auto* restart = sub->add_option("--restart", a->restart,
+                                  "Resume from a checkpoint (output.checkpoint_every); default: OUT/checkpoint.bin")
+                      ->expected(0, 1);
+  on(sub, [a, restart] {
     solver::SolveOptions o;
     o.output_dir = a->out;
     if (!a->linear.empty()) o.linear_solver = a->linear;
     o.verbose = a->verbose;
+    if (restart->count() > 0) o.restart = std::filesystem::path(a->restart);
     // solve_scene returns non-zero when the computation could not finish
     // (last converged state written); the CLI's code for that is 1.
     return solver::solve_scene(a->scene, o) == 0 ? 0 : 1;
