@@ -208,11 +208,12 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
       stages.push_back(device_stage(c, "stent"));
       break;
   }
-  // The patient's fibers need the wall mesh: added once a stage produces it.
-  const bool has_wall_mesh = std::any_of(stages.begin(), stages.end(), [](const Stage& s) {
+  // The patient's fibers need the wall mesh: added right after the stage that
+  // produces it (design order: mesh, fibers, solve), once there is one.
+  const auto wall_mesh = std::find_if(stages.begin(), stages.end(), [](const Stage& s) {
     return std::find(s.outputs.begin(), s.outputs.end(), "mesh/artery.vtu") != s.outputs.end();
   });
-  if (c.scene == Scene::patient && has_wall_mesh) stages.push_back(harmonic_fibers_stage(c));
+  if (c.scene == Scene::patient && wall_mesh != stages.end()) stages.insert(wall_mesh + 1, harmonic_fibers_stage(c));
   return stages;
 }
 
