@@ -41,6 +41,10 @@ find_package(VTK 9.1 QUIET COMPONENTS
   FiltersGeometry FiltersModeling FiltersExtraction FiltersSources ImagingCore IOImage)
 stentsim_require(VTK_FOUND libvtk9-dev "VTK 9.1 (${VTK_NOT_FOUND_MESSAGE})")
 
+# pugixml (SimVascular .pth/.ctgr project files).
+find_package(pugixml QUIET)
+stentsim_require(pugixml_FOUND libpugixml-dev "pugixml")
+
 find_package(CGAL QUIET)
 stentsim_require(CGAL_FOUND libcgal-dev "CGAL")
 

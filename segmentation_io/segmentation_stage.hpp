@@ -34,10 +34,32 @@ struct SurfaceInput {
 /// (length), remodeling (number). Calls section.finish().
 SurfaceInput parse_surface_input(ConfigMap& section);
 
-/// What an `input:` section holds: exactly one of `phantom:` or `surface:`.
+/// A SimVascular project: a path and contour groups lofted into surfaces.
+struct SimVascularInput {
+  std::filesystem::path path;                        // .pth
+  std::filesystem::path lumen;                       // .ctgr of the lumen
+  std::optional<std::filesystem::path> wall;         // .ctgr of the outer wall; absent: synthesized
+  int points_per_contour = 64;
+  SurfaceCheckOptions checks;                        // units, repair
+  WallSynthesisOptions synthesis;
+};
+
+/// Reads an `input.simvascular:` section: path (.pth), lumen (.ctgr), wall
+/// (.ctgr, optional), units, repair, points_per_contour, wall_thickness,
+/// remodeling. Calls section.finish().
+SimVascularInput parse_simvascular_input(ConfigMap& section);
+
+/// The lofted lumen (and wall, when given) of a SimVascular project, in the
+/// files' units (not yet checked).
+TriSurface loft_simvascular(const std::filesystem::path& pth, const std::filesystem::path& ctgr,
+                            int points_per_contour);
+
+/// What an `input:` section holds: exactly one of `phantom:`, `surface:` or `simvascular:`.
 struct SegmentationInput {
-  std::variant<PhantomSpec, SurfaceInput> source;
+  std::variant<PhantomSpec, SurfaceInput, SimVascularInput> source;
   bool is_phantom() const { return std::holds_alternative<PhantomSpec>(source); }
+  /// The user's files the stage reads (external inputs: editing one makes the stage stale).
+  std::vector<std::filesystem::path> input_files() const;
 };
 /// Reads the case's `input:` section (calls finish() on it and its child).
 SegmentationInput parse_segmentation_input(ConfigMap& input);

@@ -90,9 +90,7 @@ Stage segmentation_stage(const CaseConfig& c) {
     s.outputs.push_back("segmentation/centerline_true.vtp");
   } else {
     // The user's files are external inputs: editing one makes the stage stale.
-    const auto& surf = std::get<segmentation::SurfaceInput>(input.source);
-    s.inputs.push_back(surf.lumen.string());
-    if (surf.wall) s.inputs.push_back(surf.wall->string());
+    for (const auto& f : input.input_files()) s.inputs.push_back(f.string());
   }
   s.run = [input](StageContext& ctx) {
     segmentation::run_segmentation_stage(input, ctx.output("segmentation/lumen.vtp"), ctx.output("segmentation/wall.vtp"),
