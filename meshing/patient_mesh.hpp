@@ -1,0 +1,76 @@
+#pragma once
+// The patient wall mesh (paper Sections 2.1, 4.2; DESIGN.md §1, §5): layer
+// interfaces from the lumen, outer wall and centerline, lofted with OCC and
+// meshed with gmsh as one conforming tet mesh (tet10 by default).
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common/mesh_data.hpp"
+#include "common/summary.hpp"
+
+namespace stentsim::meshing {
+
+struct PatientMeshOptions {
+  std::string element = "tet10";  // tet10 | tet4
+  double size = 0.25;             // mm, target edge length (paper: mean 0.25 mm)
+  double min_size_ratio = 0.5;    // local size never below this fraction of `size`
+  int min_elements_per_layer = 1; // through each layer (local size <= thickness / n)
+  // Holzapfel et al. 2005 ratios of layer thickness to the local outer
+  // diameter (0.22 / 2.8 and 0.38 / 2.8); 0 omits the layer. The rest is intima.
+  double media_ratio = 0.0786, adventitia_ratio = 0.136;
+  bool intima = true;             // false: media reaches the lumen (paper Case 1 style)
+  double min_intima = 0.1;        // mm; thinner walls shrink media and adventitia to keep it
+  double station_spacing = 0.5;   // mm between lofted cross-sections
+  int points_per_section = 32;    // rays per cross-section
+  double end_trim = 0.2;          // mm cut off each centerline end
+  double min_scaled_jacobian = 0.1;
+  double max_aspect_ratio = 50.0;
+};
+
+/// Radii of the lumen, the layer interfaces and the outer wall along rays of
+/// the cross-sections normal to the centerline.
+struct WallSections {
+  std::vector<Eigen::Vector3d> origin, tangent, normal, binormal;  // per station
+  std::vector<double> abscissa;
+  /// radius[s][k][i]: station s, surface k (0 lumen ... last outer wall), ray i.
+  std::vector<std::vector<std::vector<double>>> radius;
+  std::vector<int> layers;  // layer between surface k and k+1 (tags::Layer)
+  double clamped_fraction = 0;  // rays where media/adventitia shrank to keep min_intima
+  Eigen::Vector3d point(std::size_t s, std::size_t k, std::size_t i) const;
+};
+
+/// Throws InputError naming the field.
+void validate(const PatientMeshOptions& o);
+
+/// Cuts the surfaces with planes normal to the centerline. InputError when a
+/// ray misses the lumen or the wall or the wall is inside the lumen.
+WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const MeshData& centerline,
+                           const PatientMeshOptions& o);
+
+struct MeshQuality {
+  double min_scaled_jacobian = 1, max_aspect_ratio = 1;
+  Eigen::Vector3d worst_sj_position = Eigen::Vector3d::Zero();
+  int worst_sj_layer = 0;
+  std::size_t worst_sj_cell = 0;
+  std::vector<std::size_t> elements_per_layer = std::vector<std::size_t>(4, 0);  // by Layer tag
+};
+
+/// Corner scaled Jacobian (1 for the regular tet) and aspect ratio
+/// (longest edge / (2 sqrt 6 inradius), 1 for the regular tet) of the tets.
+MeshQuality mesh_quality(const MeshData& m);
+
+/// gmsh adapter: loft, fragment, mesh. Returns artery MeshData (tets + tagged
+/// boundary faces, outward) and writes `msh` (gmsh 4.1, physical groups).
+MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh);
+
+/// The stage: reads the three files, writes artery.vtu and artery.msh, quality
+/// into `summary`; ComputeError when the quality is below the bounds.
+void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesystem::path& wall_vtp,
+                      const std::filesystem::path& centerline_vtp, const PatientMeshOptions& o,
+                      const std::filesystem::path& artery_vtu, const std::filesystem::path& artery_msh,
+                      Summary& summary);
+
+}  // namespace stentsim::meshing
