@@ -80,11 +80,16 @@ struct SectionState {
   Eigen::Matrix3d triad = Eigen::Matrix3d::Identity();
   Eigen::Vector3d Gamma = Eigen::Vector3d::Zero(), Omega = Eigen::Vector3d::Zero();
   Eigen::Vector3d F = Eigen::Vector3d::Zero(), M = Eigen::Vector3d::Zero();  // material resultants
+  // Elasto-plastic sections (plastic_bending.hpp): the state after the return
+  // from the history passed in; zero for elastic sections.
+  PlasticBendingHistory plastic;
+  bool yielding = false;
+  double stored_energy_density = 0.0;  // ½ Γ·F + elastic bending/torsion energy [N]
 };
 
 template <int NC, int NT>
 SectionState section_state(const ShapePoint& p, const BeamSection& sec, const std::array<Eigen::Vector3d, 4>& x,
-                           const std::array<Eigen::Quaterniond, 3>& q) {
+                           const std::array<Eigen::Quaterniond, 3>& q, const PlasticBendingHistory* history = nullptr) {
   std::array<Quat<double>, NT> qq;
   for (int i = 0; i < NT; ++i) qq[i] = qconst<double>(q[i]);
   const auto f = triad_field<double, NT>(qq);
@@ -103,17 +108,30 @@ SectionState section_state(const ShapePoint& p, const BeamSection& sec, const st
   s.Gamma = s.triad.transpose() * dr - p.Gamma0;
   s.Omega = Eigen::Vector3d(K[0], K[1], K[2]) - p.Kappa0;
   s.F = sec.CF.cwiseProduct(s.Gamma);
-  s.M = sec.CM.cwiseProduct(s.Omega);
+  if (sec.plastic) {
+    const PlasticBendingResult r =
+        plastic_bending_return(*sec.plastic, s.Omega, history ? *history : PlasticBendingHistory{});
+    s.M = r.M;
+    s.plastic = r.history;
+    s.yielding = r.yielding;
+    s.stored_energy_density = 0.5 * s.Gamma.dot(s.F) + r.elastic_energy;
+  } else {
+    s.M = sec.CM.cwiseProduct(s.Omega);
+    s.stored_energy_density = 0.5 * (s.Gamma.dot(s.F) + s.Omega.dot(s.M));
+  }
   return s;
 }
 
 template <int NC, int NT>
 double element_energy(const ElementReference& ref, const BeamSection& sec, const std::array<Eigen::Vector3d, 4>& x,
-                      const std::array<Eigen::Quaterniond, 3>& q) {
+                      const std::array<Eigen::Quaterniond, 3>& q, const PlasticBendingHistory* history = nullptr) {
+  // Stored (elastic) energy; for plastic sections from the return of each
+  // Gauss point's committed history `history[g]`.
   double e = 0.0;
-  for (const ShapePoint& p : ref.points) {
-    const SectionState s = section_state<NC, NT>(p, sec, x, q);
-    e += p.weight_ds * 0.5 * (s.Gamma.dot(s.F) + s.Omega.dot(s.M));
+  for (std::size_t g = 0; g < ref.points.size(); ++g) {
+    const ShapePoint& p = ref.points[g];
+    const SectionState s = section_state<NC, NT>(p, sec, x, q, history ? &history[g] : nullptr);
+    e += p.weight_ds * s.stored_energy_density;
   }
   return e;
 }
@@ -130,7 +148,9 @@ struct ElementSystem {
 
 template <int NC, int NT>
 void element_system(const ElementReference& ref, const BeamSection& sec, const std::array<Eigen::Vector3d, 4>& x,
-                    const std::array<Eigen::Quaterniond, 3>& q, ElementSystem<NC, NT>& out) {
+                    const std::array<Eigen::Quaterniond, 3>& q, ElementSystem<NC, NT>& out,
+                    const PlasticBendingHistory* committed = nullptr, PlasticBendingHistory* trial = nullptr,
+                    double* plastic_work = nullptr) {
   constexpr int NH = 3 * NT;
   constexpr int NX = 3 * NC;
   using J = Jet<NH>;
@@ -153,7 +173,9 @@ void element_system(const ElementReference& ref, const BeamSection& sec, const s
   Eigen::Matrix<double, NX, 1> gx = Eigen::Matrix<double, NX, 1>::Zero();
   Eigen::Matrix<double, NX, NX> Hxx = Eigen::Matrix<double, NX, NX>::Zero();
   Eigen::Matrix<double, NX, NH> Hxh = Eigen::Matrix<double, NX, NH>::Zero();
-  for (const ShapePoint& p : ref.points) {
+  if (plastic_work) *plastic_work = 0.0;
+  for (std::size_t gp = 0; gp < ref.points.size(); ++gp) {
+    const ShapePoint& p = ref.points[gp];
     // Λ = Λ_r exp(S(ψ)), ψ = Σ N_i ψ_i; Γ = exp(S(ψ))ᵀ Λ_rᵀ r' − Γ₀; K = J_r(ψ) ψ'.
     V3<J> psi{J(0.0), J(0.0), J(0.0)}, dpsi{J(0.0), J(0.0), J(0.0)};
     for (int i = 0; i < NPSI; ++i)
@@ -176,7 +198,35 @@ void element_system(const ElementReference& ref, const BeamSection& sec, const s
       F[i] = Gam[i] * sec.CF[i];
       M[i] = Om[i] * sec.CM[i];
     }
-    J pi = 0.5 * (dot(Gam, F) + dot(Om, M));
+    J pi(0.0);
+    if (sec.plastic) {
+      // Elasto-plastic moment (plastic_bending.hpp). Within a load step the
+      // radial return is the gradient of an incremental potential W(Ω) with
+      // dW/dΩ = M and d²W/dΩ² = C (the symmetric algorithmic tangent), so its
+      // second-order expansion about the current Ω, in the perturbation jets
+      // dΩ = Ω − Ω(h=0), gives the consistent residual (M·dΩ) and Hessian
+      // (dΩᵀ C dΩ + M·d²Ω); the constant is the stored elastic energy.
+      const Eigen::Vector3d Omv(Om[0].v, Om[1].v, Om[2].v);
+      const PlasticBendingResult r =
+          plastic_bending_return(*sec.plastic, Omv, committed ? committed[gp] : PlasticBendingHistory{});
+      if (trial) trial[gp] = r.history;
+      // Plastic work of the step, ∫ M_b·dΩ_pl = ∫ M_y(Ω̄) dΩ̄ (‖M_b‖ = M_y while
+      // flowing along n): exact for linear hardening, M_y at the mid value of Ω̄.
+      if (plastic_work && committed) {
+        const double a0 = committed[gp].accumulated, da = r.history.accumulated - a0;
+        const double HI = sec.plastic->hardening_modulus() * sec.plastic->inertia();
+        *plastic_work += p.weight_ds * (sec.plastic->M_y0 + HI * (a0 + 0.5 * da)) * da;
+      }
+      V3<J> dOm;
+      for (int i = 0; i < 3; ++i) dOm[i] = Om[i] - Omv[i];
+      pi = 0.5 * dot(Gam, F) + r.elastic_energy;
+      for (int i = 0; i < 3; ++i) {
+        J Ci = r.C(i, 0) * dOm[0] + r.C(i, 1) * dOm[1] + r.C(i, 2) * dOm[2];
+        pi += (r.M[i] + 0.5 * Ci) * dOm[i];
+      }
+    } else {
+      pi = 0.5 * (dot(Gam, F) + dot(Om, M));
+    }
     pi *= p.weight_ds;
     energy += pi;
     // Spatial force n = Λ_r (F + α ψ×F + a ψ×(ψ×F)) to first order, and Λ C_F Λᵀ.

@@ -2,6 +2,8 @@
 
 #include "common/error.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace stentsim::solver::beams {
@@ -83,6 +85,11 @@ BeamTerm::BeamTerm(std::string name, BeamBodyDefinition body, std::vector<BeamNo
     }
     refs_.push_back(make_element_reference(body_.interpolation, x0, q0, body_.gauss_points));
   }
+  std::size_t ngp = 0;
+  for (const ElementReference& r : refs_) hist_offset_.push_back(ngp), ngp += r.points.size();
+  hist_committed_.assign(ngp, PlasticBendingHistory{});
+  hist_trial_ = hist_committed_;
+  work_trial_.assign(refs_.size(), 0.0);
   committed_.resize(nn);
   for (int n = 0; n < nn; ++n) committed_[n] = body_.nodes[n].triad;
   accepted_ = trial_ = committed_;
@@ -124,13 +131,17 @@ void BeamTerm::assemble(const SystemState& state, Assembler& out) {
     if (!state.owns(e, ne)) continue;
     gather(state.u, e, x, q);
     const std::vector<GlobalDof> d = element_dofs(e);
+    // Plastic sections: return from the committed history; the trial history
+    // of this (latest) state is what commit() keeps.
+    const PlasticBendingHistory* hc = hist_committed_.data() + hist_offset_[e];
+    PlasticBendingHistory* ht = hist_trial_.data() + hist_offset_[e];
     if (body_.interpolation == BeamInterpolation::hermite3) {
       ElementSystem<4, 3> s;
-      element_system<4, 3>(refs_[e], body_.section, x, q, s);
+      element_system<4, 3>(refs_[e], body_.section, x, q, s, hc, ht, &work_trial_[e]);
       out.add(d, s.R, s.K);
     } else {
       ElementSystem<2, 2> s;
-      element_system<2, 2>(refs_[e], body_.section, x, q, s);
+      element_system<2, 2>(refs_[e], body_.section, x, q, s, hc, ht, &work_trial_[e]);
       out.add(d, s.R, s.K);
     }
   }
@@ -143,8 +154,21 @@ void BeamTerm::trial(const Eigen::VectorXd& du) {
   }
 }
 void BeamTerm::accept() { accepted_ = trial_; }
-void BeamTerm::commit() { committed_ = accepted_; }
-void BeamTerm::rollback() { accepted_ = trial_ = committed_; }
+void BeamTerm::commit() {
+  // Assumes the last assemble() was at the converged state (Newton checks the
+  // residual there). MPI: each rank updates the elements it owns.
+  committed_ = accepted_;
+  if (body_.section.plastic) {
+    hist_committed_ = hist_trial_;
+    for (double w : work_trial_) plastic_work_committed_ += w;
+    std::fill(work_trial_.begin(), work_trial_.end(), 0.0);
+  }
+}
+void BeamTerm::rollback() {
+  accepted_ = trial_ = committed_;
+  hist_trial_ = hist_committed_;
+  std::fill(work_trial_.begin(), work_trial_.end(), 0.0);
+}
 
 void BeamTerm::set_rotation(int node, const Eigen::Quaterniond& q) {
   trial_.at(node) = q.normalized();
@@ -163,8 +187,17 @@ SectionState BeamTerm::sample(const Eigen::VectorXd& u, std::size_t e, double xi
   std::array<Eigen::Quaterniond, 3> q;
   gather(u, e, x, q);
   const ShapePoint p = refs_[e].at(xi);
-  return body_.interpolation == BeamInterpolation::hermite3 ? section_state<4, 3>(p, body_.section, x, q)
-                                                            : section_state<2, 2>(p, body_.section, x, q);
+  // Plastic sections between Gauss points: the history of the nearest Gauss
+  // point (piecewise constant, as output only).
+  const PlasticBendingHistory* h = nullptr;
+  if (body_.section.plastic && !refs_[e].points.empty()) {
+    std::size_t best = 0;
+    for (std::size_t g = 1; g < refs_[e].points.size(); ++g)
+      if (std::abs(refs_[e].points[g].xi - xi) < std::abs(refs_[e].points[best].xi - xi)) best = g;
+    h = &hist_committed_[hist_offset_[e] + best];
+  }
+  return body_.interpolation == BeamInterpolation::hermite3 ? section_state<4, 3>(p, body_.section, x, q, h)
+                                                            : section_state<2, 2>(p, body_.section, x, q, h);
 }
 
 std::vector<SectionState> BeamTerm::section_states(const Eigen::VectorXd& u, std::size_t e) const {
@@ -172,9 +205,12 @@ std::vector<SectionState> BeamTerm::section_states(const Eigen::VectorXd& u, std
   std::array<Eigen::Quaterniond, 3> q;
   gather(u, e, x, q);
   std::vector<SectionState> s;
-  for (const ShapePoint& p : refs_[e].points)
-    s.push_back(body_.interpolation == BeamInterpolation::hermite3 ? section_state<4, 3>(p, body_.section, x, q)
-                                                                   : section_state<2, 2>(p, body_.section, x, q));
+  for (std::size_t g = 0; g < refs_[e].points.size(); ++g) {
+    const ShapePoint& p = refs_[e].points[g];
+    const PlasticBendingHistory* h = &hist_committed_[hist_offset_[e] + g];
+    s.push_back(body_.interpolation == BeamInterpolation::hermite3 ? section_state<4, 3>(p, body_.section, x, q, h)
+                                                                   : section_state<2, 2>(p, body_.section, x, q, h));
+  }
   return s;
 }
 
@@ -184,10 +220,43 @@ double BeamTerm::energy(const Eigen::VectorXd& u) const {
   std::array<Eigen::Quaterniond, 3> q;
   for (std::size_t e = 0; e < body_.elements.size(); ++e) {
     gather(u, e, x, q);
-    E += body_.interpolation == BeamInterpolation::hermite3 ? element_energy<4, 3>(refs_[e], body_.section, x, q)
-                                                            : element_energy<2, 2>(refs_[e], body_.section, x, q);
+    const PlasticBendingHistory* h = hist_committed_.data() + hist_offset_[e];
+    E += body_.interpolation == BeamInterpolation::hermite3 ? element_energy<4, 3>(refs_[e], body_.section, x, q, h)
+                                                            : element_energy<2, 2>(refs_[e], body_.section, x, q, h);
   }
   return E;
+}
+
+void BeamTerm::save_history(HistoryArchive& out, const std::string& prefix) const {
+  std::vector<double> q;
+  q.reserve(4 * committed_.size());
+  for (const auto& c : committed_) q.insert(q.end(), {c.w(), c.x(), c.y(), c.z()});
+  out.put(prefix + "triads", q);
+  if (body_.section.plastic) {
+    std::vector<double> h;
+    h.reserve(4 * hist_committed_.size());
+    for (const auto& g : hist_committed_)
+      h.insert(h.end(), {g.plastic_curvature[0], g.plastic_curvature[1], g.plastic_curvature[2], g.accumulated});
+    out.put(prefix + "plastic", h);
+    out.put(prefix + "plastic_work", plastic_work_committed_);
+  }
+}
+
+void BeamTerm::load_history(const HistoryArchive& in, const std::string& prefix) {
+  const std::vector<double>& q = in.get(prefix + "triads", 4 * static_cast<long long>(committed_.size()));
+  for (std::size_t n = 0; n < committed_.size(); ++n)
+    committed_[n] = Eigen::Quaterniond(q[4 * n], q[4 * n + 1], q[4 * n + 2], q[4 * n + 3]);
+  accepted_ = trial_ = committed_;
+  if (body_.section.plastic) {
+    const std::vector<double>& h = in.get(prefix + "plastic", 4 * static_cast<long long>(hist_committed_.size()));
+    for (std::size_t g = 0; g < hist_committed_.size(); ++g) {
+      hist_committed_[g].plastic_curvature = Eigen::Vector3d(h[4 * g], h[4 * g + 1], h[4 * g + 2]);
+      hist_committed_[g].accumulated = h[4 * g + 3];
+    }
+    hist_trial_ = hist_committed_;
+    plastic_work_committed_ = in.get_scalar(prefix + "plastic_work");
+    std::fill(work_trial_.begin(), work_trial_.end(), 0.0);
+  }
 }
 
 }  // namespace stentsim::solver::beams

@@ -69,6 +69,12 @@ class BeamTerm : public Term {
   void accept() override;
   void commit() override;
   void rollback() override;
+  /// Restart: the committed nodal triads (quaternions w, x, y, z per node) under
+  /// "<prefix>triads"; plastic sections add "<prefix>plastic" (Ω_pl and Ω̄_pl
+  /// per Gauss point) and "<prefix>plastic_work".
+  bool has_history() const override { return true; }
+  void save_history(HistoryArchive& out, const std::string& prefix) const override;
+  void load_history(const HistoryArchive& in, const std::string& prefix) override;
 
   const BeamBodyDefinition& body() const { return body_; }
   const std::vector<BeamNodeDofs>& dofs() const { return dofs_; }
@@ -89,8 +95,17 @@ class BeamTerm : public Term {
   std::vector<SectionState> section_states(const Eigen::VectorXd& u, std::size_t e) const;
   /// Section state at any ξ ∈ [−1, 1] of element e (output sampling).
   SectionState sample(const Eigen::VectorXd& u, std::size_t e, double xi) const;
-  /// Elastic energy of the body at u and the current triads.
+  /// Stored (elastic) energy of the body at u and the current triads; for
+  /// plastic sections from the return of the committed history.
   double energy(const Eigen::VectorXd& u) const;
+
+  /// Elasto-plastic sections: Gauss-point history of element e, point g
+  /// (committed, and the trial state of the last assemble()).
+  const PlasticBendingHistory& committed_plastic(std::size_t e, int g) const { return hist_committed_[hist_offset_[e] + g]; }
+  const PlasticBendingHistory& trial_plastic(std::size_t e, int g) const { return hist_trial_[hist_offset_[e] + g]; }
+  /// Plastic work ∫∫ M_b·dΩ_pl ds summed over committed steps (= ∫ M_y dΩ̄,
+  /// exact for linear hardening) [N·mm].
+  double plastic_work() const { return plastic_work_committed_; }
 
  private:
   void gather(const Eigen::VectorXd& u, std::size_t e, std::array<Eigen::Vector3d, 4>& x,
@@ -101,6 +116,10 @@ class BeamTerm : public Term {
   std::vector<BeamNodeDofs> dofs_;
   std::vector<ElementReference> refs_;
   std::vector<Eigen::Quaterniond> committed_, accepted_, trial_;
+  std::vector<std::size_t> hist_offset_;  // first Gauss point of element e
+  std::vector<PlasticBendingHistory> hist_committed_, hist_trial_;
+  std::vector<double> work_trial_;  // plastic work increment of element e in the last assemble
+  double plastic_work_committed_ = 0.0;
 };
 
 }  // namespace stentsim::solver::beams

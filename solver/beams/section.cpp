@@ -16,6 +16,13 @@ BeamSection BeamSection::circular(double E, double G, double R, double shear_fac
   return s;
 }
 
+BeamSection BeamSection::circular_plastic(const PlasticBendingLaw& law, double shear_factor) {
+  law.validate("plastic beam section");
+  BeamSection s = circular(law.E, law.G, law.radius, shear_factor);
+  s.plastic = law;
+  return s;
+}
+
 BeamSection BeamSection::from_values(double E, double G, double A, double A2, double A3, double I2, double I3,
                                      double IT) {
   BeamSection s;
