@@ -4,8 +4,10 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "segmentation_io/label_image.hpp"
 #include "segmentation_io/simvascular_io.hpp"
 #include "segmentation_io/surface_distance.hpp"
+#include "segmentation_io/tree_input.hpp"
 
 namespace stentsim::segmentation {
 
@@ -44,6 +46,50 @@ SimVascularInput parse_simvascular_input(ConfigMap& section) {
   return in;
 }
 
+LabelImageInput parse_label_image_input(ConfigMap& section) {
+  LabelImageInput in;
+  in.file = section.path("file");
+  in.lumen_label = section.integer("lumen_label", 1);
+  if (section.has("wall_label")) in.wall_label = section.integer("wall_label");
+  in.smoothing_iterations = section.integer("smoothing_iterations", 20, Range::between(0, 500));
+  in.end_trim = section.quantity("end_trim", units::kLength, 0.0, Range::non_negative());
+  in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
+  in.checks.repair = section.boolean("repair", true);
+  in.synthesis.wall_thickness = section.quantity("wall_thickness", units::kLength, 0.5, Range::positive());
+  in.synthesis.remodeling = section.number("remodeling", 0.0, Range::between(0, 1));
+  section.finish();
+  if (in.wall_label && *in.wall_label == in.lumen_label)
+    section.fail("wall_label", "must differ from lumen_label");
+  std::string f = in.file.string();
+  auto ends = [&](const std::string& e) { return f.size() >= e.size() && f.compare(f.size() - e.size(), e.size(), e) == 0; };
+  if (!(ends(".nii") || ends(".nii.gz") || ends(".nrrd") || ends(".nhdr") || ends(".mha") || ends(".mhd")))
+    section.fail("file", fmt::format("expected a NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd) "
+                                     "label image, got `{}`", f));
+  return in;
+}
+
+TreeInput parse_tree_input(ConfigMap& section) {
+  TreeInput in;
+  in.file = section.path("file");
+  in.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
+  auto f = section.numbers("from", 3);
+  in.from = {f[0], f[1], f[2]};
+  const bool longest = section.boolean("longest_path_from_inlet", false);
+  if (section.has("to")) {
+    auto t = section.numbers("to", 3);
+    in.to = Eigen::Vector3d(t[0], t[1], t[2]);
+  }
+  if (section.has("roi_length")) in.roi_length = section.quantity("roi_length", units::kLength, std::nullopt, Range::positive());
+  in.repair = section.boolean("repair", true);
+  in.synthesis.wall_thickness = section.quantity("wall_thickness", units::kLength, 0.5, Range::positive());
+  in.synthesis.remodeling = section.number("remodeling", 0.0, Range::between(0, 1));
+  section.finish();
+  if (longest == bool(in.to))
+    section.fail(in.to ? "to" : "longest_path_from_inlet",
+                 "expected exactly one of `to: [x, y, z]` or `longest_path_from_inlet: true`");
+  return in;
+}
+
 TriSurface loft_simvascular(const std::filesystem::path& pth, const std::filesystem::path& ctgr,
                             int points_per_contour) {
   SvPath path = read_simvascular_path(pth);
@@ -60,17 +106,29 @@ std::vector<std::filesystem::path> SegmentationInput::input_files() const {
   } else if (const auto* sv = std::get_if<SimVascularInput>(&source)) {
     files = {sv->path, sv->lumen};
     if (sv->wall) files.push_back(*sv->wall);
+  } else if (const auto* li = std::get_if<LabelImageInput>(&source)) {
+    files.push_back(li->file);
+  } else if (const auto* tr = std::get_if<TreeInput>(&source)) {
+    files.push_back(tr->file);
   }
   return files;
 }
 
 SegmentationInput parse_segmentation_input(ConfigMap& input) {
-  int count = int(input.has("phantom")) + int(input.has("surface")) + int(input.has("simvascular"));
-  if (count != 1) input.fail("", "expected exactly one of `phantom:`, `surface:` or `simvascular:`");
+  int count = int(input.has("phantom")) + int(input.has("surface")) + int(input.has("simvascular")) +
+              int(input.has("label_image")) + int(input.has("tree"));
+  if (count != 1)
+    input.fail("", "expected exactly one of `phantom:`, `surface:`, `simvascular:`, `label_image:` or `tree:`");
   SegmentationInput out;
   if (input.has("phantom")) {
     auto sec = input.map("phantom");
     out.source = parse_phantom(sec);
+  } else if (input.has("tree")) {
+    auto sec = input.map("tree");
+    out.source = parse_tree_input(sec);
+  } else if (input.has("label_image")) {
+    auto sec = input.map("label_image");
+    out.source = parse_label_image_input(sec);
   } else if (input.has("simvascular")) {
     auto sec = input.map("simvascular");
     out.source = parse_simvascular_input(sec);
@@ -142,6 +200,54 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     checks = sv->checks;
     synthesis = sv->synthesis;
     kind = "simvascular";
+  } else if (const auto* li = std::get_if<LabelImageInput>(&input.source)) {
+    LabelSurfaceOptions lo;
+    lo.smoothing_iterations = li->smoothing_iterations;
+    lo.end_trim = li->end_trim / unit_length_in_mm(li->checks.units);  // mm → the image's units
+    lo.labels = {li->lumen_label};
+    lumen_raw = label_image_surface(li->file, lo);
+    lumen_name = li->file.string() + fmt::format(" (label {})", li->lumen_label);
+    if (li->wall_label) {
+      lo.labels = {li->lumen_label, *li->wall_label};
+      wall_raw = label_image_surface(li->file, lo);
+      wall_name = li->file.string() + fmt::format(" (labels {} and {})", li->lumen_label, *li->wall_label);
+      have_wall = true;
+    }
+    checks = li->checks;
+    synthesis = li->synthesis;
+    kind = "label_image";
+  } else if (const auto* tr = std::get_if<TreeInput>(&input.source)) {
+    TriSurface tree = read_surface_file(tr->file);
+    const double scale = unit_length_in_mm(tr->units);
+    for (auto& x : tree.points) x *= scale;
+    {  // Size says other units? (the same plausibility bounds as the surface checks)
+      const SurfaceCheckOptions bounds;
+      const double diag = bounding_box_diagonal(tree);
+      if (diag < bounds.min_size || diag > bounds.max_size)
+        throw InputError(fmt::format("{}: the tree is {:.4g} mm across with units: {}; a coronary tree is {:g} to {:g} mm{}",
+                                     tr->file.string(), diag, tr->units, bounds.min_size, bounds.max_size,
+                                     diag * 1000 >= bounds.min_size && diag * 1000 <= bounds.max_size
+                                         ? " (the file looks like it is in metres: set units: m)"
+                                         : ""));
+    }
+    Eigen::Vector3d to = tr->to ? *tr->to : farthest_point_along_surface(tree, tr->from, 0.3);
+    BranchSegment seg = extract_branch(tree, tr->from, to);
+    summary.set("tree_segment_length", seg.centerline.length, "mm");
+    summary.set("tree_side_branches_cut", seg.side_branches_cut);
+    if (!tr->to) summary.note("tree_path_end", fmt::format("longest path from the inlet ends at ({:.3f}, {:.3f}, {:.3f}) mm",
+                                                           to.x(), to.y(), to.z()));
+    lumen_raw = std::move(seg.lumen);
+    if (tr->roi_length) {
+      double s0 = 0, s1 = 0;
+      lumen_raw = clip_region_of_interest(lumen_raw, seg.centerline, *tr->roi_length, s0, s1);
+      summary.set("roi_start_abscissa", s0, "mm");
+      summary.set("roi_end_abscissa", s1, "mm");
+    }
+    lumen_name = tr->file.string() + " (extracted segment)";
+    checks.units = "mm";  // already scaled
+    checks.repair = tr->repair;
+    synthesis = tr->synthesis;
+    kind = "tree";
   } else {
     const auto& in = std::get<SurfaceInput>(input.source);
     lumen_raw = read_surface_file(in.lumen);

@@ -54,9 +54,42 @@ SimVascularInput parse_simvascular_input(ConfigMap& section);
 TriSurface loft_simvascular(const std::filesystem::path& pth, const std::filesystem::path& ctgr,
                             int points_per_contour);
 
-/// What an `input:` section holds: exactly one of `phantom:`, `surface:` or `simvascular:`.
+/// A label image: lumen label (and optional wall label) → surfaces.
+struct LabelImageInput {
+  std::filesystem::path file;            // .nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd
+  int lumen_label = 1;
+  std::optional<int> wall_label;         // the wall region's label; the outer wall encloses lumen ∪ wall
+  int smoothing_iterations = 20;
+  double end_trim = 0;                   // mm; 0: automatic (see LabelSurfaceOptions)
+  SurfaceCheckOptions checks;
+  WallSynthesisOptions synthesis;
+};
+
+/// Reads an `input.label_image:` section: file, lumen_label, wall_label,
+/// smoothing_iterations, end_trim (length), units, repair, wall_thickness,
+/// remodeling. Calls section.finish().
+LabelImageInput parse_label_image_input(ConfigMap& section);
+
+/// A coronary tree (closed surface): one vessel out of it.
+struct TreeInput {
+  std::filesystem::path file;
+  std::string units = "mm";
+  Eigen::Vector3d from = Eigen::Vector3d::Zero();  // mm, inlet (proximal point)
+  std::optional<Eigen::Vector3d> to;               // mm; absent: longest path from the inlet
+  std::optional<double> roi_length;                // mm around the stenosis; absent: the whole segment
+  bool repair = true;
+  WallSynthesisOptions synthesis;
+};
+
+/// Reads an `input.tree:` section: file, units, from ([x, y, z] in mm), to
+/// ([x, y, z] in mm) or longest_path_from_inlet: true, roi_length (length,
+/// optional), repair, wall_thickness, remodeling. Calls section.finish().
+TreeInput parse_tree_input(ConfigMap& section);
+
+/// What an `input:` section holds: exactly one of `phantom:`, `surface:`,
+/// `simvascular:`, `label_image:` or `tree:`.
 struct SegmentationInput {
-  std::variant<PhantomSpec, SurfaceInput, SimVascularInput> source;
+  std::variant<PhantomSpec, SurfaceInput, SimVascularInput, LabelImageInput, TreeInput> source;
   bool is_phantom() const { return std::holds_alternative<PhantomSpec>(source); }
   /// The user's files the stage reads (external inputs: editing one makes the stage stale).
   std::vector<std::filesystem::path> input_files() const;

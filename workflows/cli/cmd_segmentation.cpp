@@ -6,6 +6,7 @@
 #include "common/summary.hpp"
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/phantom.hpp"
+#include "segmentation_io/segmentation_stage.hpp"
 #include "workflows/cli/commands.hpp"
 
 namespace stentsim::cli {
@@ -25,6 +26,30 @@ void register_segmentation(CLI::App& app) {
     segmentation::write_phantom(segmentation::phantom_preset(p->preset, p->seed), p->out, summary);
     summary.write(std::filesystem::path(p->out) / "summary.yaml");
     std::printf("wrote %s/{lumen,wall,centerline_true}.vtp\n", p->out.c_str());
+    return 0;
+  });
+
+  // The segmentation stage alone: a case file (its `input:` section) or a
+  // file holding just an input section, e.g. {simvascular: {path, lumen}}.
+  struct SegmentArgs {
+    std::string input, out;
+  };
+  auto g = std::make_shared<SegmentArgs>();
+  auto* seg = app.add_subcommand(
+      "segmentation", "Make lumen.vtp and wall.vtp from a case's input (phantom, surface, simvascular, label_image)");
+  seg->add_option("INPUT", g->input, "Case file, or a YAML file holding one input section")->required();
+  seg->add_option("--out", g->out, "Output folder")->required();
+  on(seg, [g] {
+    ConfigMap root = ConfigMap::load(g->input);
+    ConfigMap input = root.has("input") ? root.map("input") : root;
+    segmentation::SegmentationInput in = segmentation::parse_segmentation_input(input);
+    std::filesystem::create_directories(g->out);
+    const std::filesystem::path out(g->out);
+    Summary summary;
+    segmentation::run_segmentation_stage(in, out / "lumen.vtp", out / "wall.vtp", summary,
+                                         in.is_phantom() ? out / "centerline_true.vtp" : std::filesystem::path());
+    summary.write(out / "summary.yaml");
+    std::printf("wrote %s/{lumen,wall}.vtp\n", g->out.c_str());
     return 0;
   });
 

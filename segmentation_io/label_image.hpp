@@ -1,0 +1,29 @@
+#pragma once
+// Label images (issue 3): NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr) and
+// MetaImage (.mha, .mhd) through VTK's readers; a label's surface by discrete
+// flying edges with volume-preserving windowed-sinc smoothing, in the image's
+// physical coordinates, opened at the vessel's two ends by planar cuts.
+#include <filesystem>
+#include <vector>
+
+#include "segmentation_io/triangle_surface.hpp"
+
+namespace stentsim::segmentation {
+
+struct LabelSurfaceOptions {
+  std::vector<int> labels;     // voxels with any of these labels are inside (lumen: {1}; outer wall: {1, 2})
+  int smoothing_iterations = 20;
+  double passband = 0.05;      // windowed-sinc pass band (smaller: smoother)
+  double end_trim = 0;         // mm cut off each end (past the rounded cap); 0: 3 × the largest voxel size + 0.5 × radius
+  bool open_ends = true;       // false: the closed surface
+};
+
+/// The surface of the labelled region in physical coordinates (NIfTI: the
+/// sform when set, else the qform; NRRD/MetaImage: origin and spacing). Open
+/// ends: the vessel's axis ends are found from the voxel centroids of slabs
+/// two and four radii in from each end, and the surface is cut by planes
+/// normal to that axis `end_trim` inside the extreme. InputError naming the
+/// file for an unknown extension, an unreadable file or no voxel with a label.
+TriSurface label_image_surface(const std::filesystem::path& file, const LabelSurfaceOptions& options);
+
+}  // namespace stentsim::segmentation

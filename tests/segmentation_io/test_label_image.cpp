@@ -1,0 +1,149 @@
+// Label images (issue 3): a cylinder label written by VTK (NIfTI with a
+// rotating, translating qform; MetaImage with non-unit spacing and an origin
+// offset) comes back as an open tube of the right radius, volume and place.
+#include <gtest/gtest.h>
+#include <vtkImageData.h>
+#include <vtkMatrix4x4.h>
+#include <vtkMetaImageWriter.h>
+#include <vtkNIFTIImageWriter.h>
+#include <vtkSmartPointer.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+
+#include "common/error.hpp"
+#include "segmentation_io/label_image.hpp"
+
+using namespace stentsim;
+using namespace stentsim::segmentation;
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+
+namespace {
+
+const double kR = 1.2, kRw = 1.8;        // lumen and outer wall radius, mm
+const double kSp[3] = {0.1, 0.08, 0.15};  // non-unit, anisotropic spacing
+const int kDim[3] = {50, 50, 80};
+
+// Labels 1 (lumen, r < R) and 2 (wall, R ≤ r < Rw) around the axis through
+// the middle of the x-y extent, for slices 5..74 (the ends are inside the image).
+vtkSmartPointer<vtkImageData> cylinder(const double origin[3]) {
+  auto im = vtkSmartPointer<vtkImageData>::New();
+  im->SetDimensions(kDim[0], kDim[1], kDim[2]);
+  im->SetSpacing(kSp[0], kSp[1], kSp[2]);
+  im->SetOrigin(origin[0], origin[1], origin[2]);
+  im->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  auto* p = static_cast<unsigned char*>(im->GetScalarPointer());
+  const double cx = 0.5 * (kDim[0] - 1) * kSp[0], cy = 0.5 * (kDim[1] - 1) * kSp[1];
+  for (int k = 0; k < kDim[2]; ++k)
+    for (int j = 0; j < kDim[1]; ++j)
+      for (int i = 0; i < kDim[0]; ++i) {
+        double r = std::hypot(i * kSp[0] - cx, j * kSp[1] - cy);
+        unsigned char v = 0;
+        if (k >= 5 && k <= 74) v = r < kR ? 1 : (r < kRw ? 2 : 0);
+        p[i + kDim[0] * (j + kDim[1] * k)] = v;
+      }
+  return im;
+}
+
+struct TubeStats {
+  double mean_r = 0, max_dev = 0, length = 0, volume = 0;
+};
+
+// Radius about the axis through `a` along `d`, the length between the cuts
+// and the capped volume.
+TubeStats measure(const TriSurface& s, const Vector3d& a, const Vector3d& d) {
+  TubeStats t;
+  double smin = 1e300, smax = -1e300;
+  for (const auto& x : s.points) {
+    double along = (x - a).dot(d);
+    smin = std::min(smin, along), smax = std::max(smax, along);
+    t.mean_r += (x - a - along * d).norm();
+  }
+  t.mean_r /= double(s.points.size());
+  for (const auto& x : s.points) {
+    double along = (x - a).dot(d);
+    t.max_dev = std::max(t.max_dev, std::abs((x - a - along * d).norm() - t.mean_r));
+  }
+  t.length = smax - smin;
+  auto loops = boundary_loops(s);
+  EXPECT_EQ(loops.size(), 2u);
+  t.volume = signed_volume(capped(s, loops));
+  return t;
+}
+
+}  // namespace
+
+TEST(LabelImage, MetaImageCylinderInPhysicalCoordinates) {
+  fs::path dir = fs::temp_directory_path() / "stentsim_label_mha";
+  fs::create_directories(dir);
+  const double origin[3] = {10.0, -5.0, 3.0};
+  auto w = vtkSmartPointer<vtkMetaImageWriter>::New();
+  w->SetInputData(cylinder(origin));
+  w->SetFileName((dir / "labels.mha").c_str());
+  w->SetCompression(false);
+  w->Write();
+  LabelSurfaceOptions o;
+  o.labels = {1};
+  TriSurface lumen = label_image_surface(dir / "labels.mha", o);
+  const Vector3d a(origin[0] + 0.5 * (kDim[0] - 1) * kSp[0], origin[1] + 0.5 * (kDim[1] - 1) * kSp[1], 0);
+  TubeStats t = measure(lumen, a, Vector3d::UnitZ());
+  const double exact = M_PI * kR * kR * t.length;
+  std::printf("mha lumen: mean radius %.4f (R %.2f, rel %.2e), max deviation %.4f, length %.3f, volume %.4f vs "
+              "%.4f (rel %.2e)\n", t.mean_r, kR, t.mean_r / kR - 1, t.max_dev, t.length, t.volume, exact,
+              t.volume / exact - 1);
+  EXPECT_NEAR(t.mean_r, kR, 0.02 * kR);
+  EXPECT_LT(t.max_dev, 0.08);  // under one voxel
+  EXPECT_NEAR(t.volume, exact, 0.03 * exact);
+  EXPECT_GT(t.length, 6.0);    // 10.5 mm label less the trimmed caps
+  // Outer wall: labels 1 and 2 together.
+  o.labels = {1, 2};
+  TriSurface wall = label_image_surface(dir / "labels.mha", o);
+  TubeStats tw = measure(wall, a, Vector3d::UnitZ());
+  std::printf("mha wall: mean radius %.4f (Rw %.2f)\n", tw.mean_r, kRw);
+  EXPECT_NEAR(tw.mean_r, kRw, 0.02 * kRw);
+  // Errors name the file.
+  o.labels = {7};
+  try {
+    label_image_surface(dir / "labels.mha", o);
+    ADD_FAILURE() << "no error for a missing label";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("labels.mha"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("7"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(label_image_surface(dir / "labels.png", o), InputError);
+  fs::remove_all(dir);
+}
+
+TEST(LabelImage, NiftiQformRotatesAndTranslates) {
+  fs::path dir = fs::temp_directory_path() / "stentsim_label_nii";
+  fs::create_directories(dir);
+  const double zero[3] = {0, 0, 0};
+  // qform: 90° about x (data z → world −y... ) plus a translation.
+  auto q = vtkSmartPointer<vtkMatrix4x4>::New();
+  q->Identity();
+  q->SetElement(1, 1, 0), q->SetElement(1, 2, -1), q->SetElement(2, 1, 1), q->SetElement(2, 2, 0);
+  q->SetElement(0, 3, -20.0), q->SetElement(1, 3, 7.0), q->SetElement(2, 3, 40.0);
+  auto w = vtkSmartPointer<vtkNIFTIImageWriter>::New();
+  w->SetInputData(cylinder(zero));
+  w->SetQFormMatrix(q);
+  w->SetFileName((dir / "labels.nii.gz").c_str());
+  w->Write();
+  LabelSurfaceOptions o;
+  o.labels = {1};
+  TriSurface lumen = label_image_surface(dir / "labels.nii.gz", o);
+  // Axis in data coordinates through (cx, cy, ·) along z → world through q·(cx, cy, 0) along q·e_z.
+  const double cx = 0.5 * (kDim[0] - 1) * kSp[0], cy = 0.5 * (kDim[1] - 1) * kSp[1];
+  double in[4] = {cx, cy, 0, 1}, out[4];
+  q->MultiplyPoint(in, out);
+  const Vector3d a(out[0], out[1], out[2]), d(0, -1, 0);
+  TubeStats t = measure(lumen, a, d);
+  const double exact = M_PI * kR * kR * t.length;
+  std::printf("nii lumen: mean radius %.4f (rel %.2e), max deviation %.4f, length %.3f, volume rel %.2e\n", t.mean_r,
+              t.mean_r / kR - 1, t.max_dev, t.length, t.volume / exact - 1);
+  EXPECT_NEAR(t.mean_r, kR, 0.02 * kR);
+  EXPECT_LT(t.max_dev, 0.08);
+  EXPECT_NEAR(t.volume, exact, 0.03 * exact);
+  fs::remove_all(dir);
+}
