@@ -19,6 +19,8 @@ PKGS=(
   libplplot-dev plplot-driver-cairo
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # Slurm back-end of `stentsim cohort` (its tests start a private single-node cluster)
+  slurmctld slurmd slurm-client munge
 )
 
 SUDO=""

@@ -10,6 +10,7 @@
 #include "workflows/case_stages.hpp"
 #include "workflows/cli/commands.hpp"
 #include "workflows/cohort/cohort_runner.hpp"
+#include "workflows/cohort/cohort_slurm.hpp"
 #include "workflows/version.hpp"
 
 namespace stentsim::cli {
@@ -64,12 +65,12 @@ void register_cohort(CLI::App& app) {
   cohort->require_subcommand(1);
   struct Args {
     std::string file, cases, until, only;
-    std::string force;
+    std::string force, backend;
     bool dry_run = false;
     int workers = 0;
   };
   auto a = std::make_shared<Args>();
-  auto* run = cohort->add_subcommand("run", "Run every case's pipeline incrementally on local workers");
+  auto* run = cohort->add_subcommand("run", "Run every case's pipeline incrementally (local workers or Slurm)");
   run->add_option("cohort", a->file, "Cohort file (YAML)")->required();
   run->add_option("--workers", a->workers, "Worker processes (default: the cohort file's, else the core count)")
       ->check(CLI::Range(1, 1024));
@@ -78,8 +79,11 @@ void register_cohort(CLI::App& app) {
   run->add_option("--only", a->only, "Run only this stage of each case");
   auto* force = run->add_option("--force", a->force, "Re-run every stage, or only STAGE")->expected(0, 1);
   run->add_flag("--dry-run", a->dry_run, "Print each case's plan; run nothing");
+  run->add_option("--backend", a->backend, "local (worker pool) or slurm (one batch job per case); default: the cohort file's")
+      ->check(CLI::IsMember({"local", "slurm"}));
   on(run, [a, force] {
-    const auto c = workflows::load_cohort(a->file);
+    auto c = workflows::load_cohort(a->file);
+    if (!a->backend.empty()) c.backend = a->backend;
     workflows::CohortRunOptions o;
     o.workers = a->workers;
     o.only_cases = split(a->cases);
@@ -91,7 +95,7 @@ void register_cohort(CLI::App& app) {
       if (!a->force.empty()) o.run_args.push_back(a->force);
     }
     if (a->dry_run) o.run_args.push_back("--dry-run");
-    const auto rep = workflows::run_cohort(c, o, std::cout);
+    const auto rep = c.backend == "slurm" ? workflows::run_cohort_slurm(c, o, std::cout) : workflows::run_cohort(c, o, std::cout);
     workflows::write_cohort_summary(c, rep);
     std::cout << fmt::format("{} cases: {} as expected, {} unexpected failures; summary: {}\n", rep.cases.size(),
                              rep.cases.size() - static_cast<std::size_t>(rep.unexpected()), rep.unexpected(),

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <regex>
+#include <sstream>
 #include <set>
 
 #include "common/config.hpp"
@@ -66,6 +67,22 @@ CohortConfig load_cohort(const fs::path& file) {
   c.work_dir = top.path("work_dir", fs::path(file.stem().string() + ".work"));
   c.workers = top.integer("workers", 0, Range::between(0, 1024));
   c.ranks_per_case = top.integer("ranks_per_case", 1, Range::between(1, 1024));
+  c.backend = top.choice("backend", {"local", "slurm"}, std::string("local"));
+  if (auto sm = top.optional_map("slurm")) {
+    c.slurm.partition = sm->string("partition", std::string());
+    c.slurm.time_limit = sm->string("time_limit", std::string());
+    c.slurm.memory = sm->string("memory", std::string());
+    c.slurm.cpus_per_case = sm->integer("cpus_per_case", 1, Range::between(1, 1024));
+    c.slurm.poll_interval_s = sm->number("poll_interval_s", 1.0, Range::between(0.05, 600));
+    // One string of options separated by spaces (no shell quoting is applied).
+    std::istringstream extra(sm->string("extra_sbatch_options", std::string()));
+    for (std::string opt; extra >> opt;) {
+      if (opt.rfind("-", 0) != 0)
+        sm->fail("extra_sbatch_options", fmt::format("'{}' is not an sbatch option (options start with '-')", opt));
+      c.slurm.extra_options.push_back(opt);
+    }
+    sm->finish();
+  }
   if (top.has("template") && top.has("template_case")) top.fail("template", "give either 'template' (a case file) or 'template_case' (inline), not both");
   if (top.has("template")) {
     const fs::path t = top.path("template");

@@ -17,6 +17,16 @@ struct CohortCase {
   std::optional<std::string> expect_failure;  // stage at which this case is meant to fail
 };
 
+/// `backend: slurm` settings (`slurm:` map of the cohort file).
+struct SlurmOptions {
+  std::string partition;                  // empty: the cluster's default
+  std::string time_limit;                 // sbatch --time (e.g. "30" or "1:00:00"); empty: the partition's
+  std::string memory;                     // sbatch --mem (e.g. "4G"); empty: the partition's
+  int cpus_per_case = 1;                  // --cpus-per-task
+  std::vector<std::string> extra_options; // extra sbatch options ("extra_sbatch_options: --qos=short --mem-per-cpu=1G")
+  double poll_interval_s = 1.0;           // squeue polling period
+};
+
 struct CohortConfig {
   std::filesystem::path file;
   std::string name;
@@ -26,6 +36,8 @@ struct CohortConfig {
   std::vector<CohortCase> cases;
   int workers = 0;                         // 0: the core count
   int ranks_per_case = 1;
+  std::string backend = "local";           // local | slurm
+  SlurmOptions slurm;
 };
 
 /// Reads and validates a cohort file, including every case's merged

@@ -89,18 +89,46 @@ int CohortReport::unexpected() const {
   return static_cast<int>(std::count_if(cases.begin(), cases.end(), [](const CaseOutcome& c) { return !c.as_expected(); }));
 }
 
+CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_code, double wall_s) {
+  const fs::path dir = c.work_dir / k.id;
+  CaseOutcome r;
+  r.id = k.id;
+  r.wall_s = wall_s;
+  r.exit_code = exit_code;
+  r.failed_stage = r.exit_code ? failed_stage_of(dir / "work" / "manifest.yaml") : "";
+  if (r.exit_code == 0)
+    // With --until/--only the stage meant to fail may not have run: then "done".
+    r.status = k.expect_failure && stage_succeeded(dir / "work" / "manifest.yaml", *k.expect_failure) ? "succeeded unexpectedly" : "done";
+  else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
+  else r.status = r.exit_code == 130 ? "interrupted" : "failed";
+  if (r.exit_code) r.message = tail_lines(dir / "run.log", 3);
+  return r;
+}
+
+void sort_like_cohort(const CohortConfig& c, std::vector<CaseOutcome>& cases) {
+  auto pos = [&](const std::string& id) {
+    return std::find_if(c.cases.begin(), c.cases.end(), [&](const CohortCase& k) { return k.id == id; }) - c.cases.begin();
+  };
+  std::stable_sort(cases.begin(), cases.end(), [&](const CaseOutcome& a, const CaseOutcome& b) { return pos(a.id) < pos(b.id); });
+}
+
+std::vector<std::size_t> selected_cases(const CohortConfig& c, const std::vector<std::string>& only) {
+  for (const auto& id : only)
+    if (std::none_of(c.cases.begin(), c.cases.end(), [&](const CohortCase& k) { return k.id == id; }))
+      throw InputError(fmt::format("{}: --cases names '{}', which is not a case of this cohort", c.file.string(), id));
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < c.cases.size(); ++i)
+    if (only.empty() || std::count(only.begin(), only.end(), c.cases[i].id)) todo.push_back(i);
+  return todo;
+}
+
 int concurrent_cases(int workers, int ranks_per_case, int cores) {
   return std::max(1, std::min(workers, cores / std::max(1, ranks_per_case)));
 }
 
 CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out) {
   const auto case_files = materialize_cases(c);
-  std::vector<std::size_t> todo;
-  for (std::size_t i = 0; i < c.cases.size(); ++i)
-    if (o.only_cases.empty() || std::count(o.only_cases.begin(), o.only_cases.end(), c.cases[i].id)) todo.push_back(i);
-  for (const auto& id : o.only_cases)
-    if (std::none_of(c.cases.begin(), c.cases.end(), [&](const CohortCase& k) { return k.id == id; }))
-      throw InputError(fmt::format("{}: --cases names '{}', which is not a case of this cohort", c.file.string(), id));
+  const std::vector<std::size_t> todo = selected_cases(c, o.only_cases);
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int workers = o.workers > 0 ? o.workers : c.workers > 0 ? c.workers : cores;
   const int slots = concurrent_cases(workers, c.ranks_per_case, cores);
@@ -140,19 +168,8 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
     }
     auto it = running.find(pid);
     if (it == running.end()) continue;
-    const auto& k = c.cases[it->second.index];
-    const fs::path dir = c.work_dir / k.id;
-    CaseOutcome r;
-    r.id = k.id;
-    r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.failed_stage = r.exit_code ? failed_stage_of(dir / "work" / "manifest.yaml") : "";
-    if (r.exit_code == 0)
-      // With --until/--only the stage meant to fail may not have run: then "done".
-      r.status = k.expect_failure && stage_succeeded(dir / "work" / "manifest.yaml", *k.expect_failure) ? "succeeded unexpectedly" : "done";
-    else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
-    else r.status = r.exit_code == 130 ? "interrupted" : "failed";
-    if (r.exit_code) r.message = tail_lines(dir / "run.log", 3);
+    CaseOutcome r = case_outcome(c, c.cases[it->second.index], WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
+                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count());
     running.erase(it);
     durations.push_back(r.wall_s);
     done.push_back(r);
@@ -171,12 +188,7 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
   sigaction(SIGTERM, &old_term, nullptr);
   CohortReport rep;
   rep.cases = done;
-  std::sort(rep.cases.begin(), rep.cases.end(), [&](const CaseOutcome& a, const CaseOutcome& b) {
-    auto pos = [&](const std::string& id) {
-      return std::find_if(c.cases.begin(), c.cases.end(), [&](const CohortCase& k) { return k.id == id; }) - c.cases.begin();
-    };
-    return pos(a.id) < pos(b.id);
-  });
+  sort_like_cohort(c, rep.cases);
   if (g_stop) throw Interrupted();
   return rep;
 }

@@ -35,6 +35,16 @@ struct CohortReport {
   int exit_code() const { return unexpected() ? 1 : 0; }
 };
 
+/// The outcome of one case from its exit status and its manifest (shared by
+/// the back-ends): status, failed stage and the last lines of its run.log.
+CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_code, double wall_s);
+
+/// Indices of the cases to run (all, or those --cases names; unknown ids are an InputError).
+std::vector<std::size_t> selected_cases(const CohortConfig& c, const std::vector<std::string>& only);
+
+/// Orders outcomes as the cases appear in the cohort file.
+void sort_like_cohort(const CohortConfig& c, std::vector<CaseOutcome>& cases);
+
 /// Concurrent cases: min(workers, cores / ranks_per_case), at least 1.
 int concurrent_cases(int workers, int ranks_per_case, int cores);
 
