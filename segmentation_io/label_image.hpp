@@ -16,13 +16,16 @@ struct LabelSurfaceOptions {
   double passband = 0.05;      // windowed-sinc pass band (smaller: smoother)
   double end_trim = 0;         // mm cut off each end (past the rounded cap); 0: 3 × the largest voxel size + 0.5 × radius
   bool open_ends = true;       // false: the closed surface
+  std::vector<int> axis_labels;  // voxels that place the end cuts (empty: `labels`); lumen and wall
+                                 // surfaces cut with the same axis_labels get the same planes
 };
 
 /// The surface of the labelled region in physical coordinates (NIfTI: the
 /// sform when set, else the qform; NRRD/MetaImage: origin and spacing). Open
 /// ends: the vessel's axis ends are found from the voxel centroids of slabs
 /// two and four radii in from each end, and the surface is cut by planes
-/// normal to that axis `end_trim` inside the extreme. InputError naming the
+/// normal to that axis `end_trim` inside the extreme voxel centre (all from
+/// the `axis_labels` voxels). InputError naming the
 /// file for an unknown extension, an unreadable file or no voxel with a label.
 TriSurface label_image_surface(const std::filesystem::path& file, const LabelSurfaceOptions& options);
 

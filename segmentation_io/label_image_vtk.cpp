@@ -84,17 +84,21 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   mask->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
   auto* m = static_cast<unsigned char*>(mask->GetScalarPointer());
   std::fill(m, m + std::size_t(nx) * ny * nz, 0);
-  std::vector<Vector3d> voxels;  // data coordinates of labelled voxels
+  const std::vector<int>& axis_labels = o.axis_labels.empty() ? o.labels : o.axis_labels;
+  std::vector<Vector3d> voxels;  // data coordinates of the voxels that place the end cuts
+  std::size_t labelled = 0;
   for (int k = 0; k < dims[2]; ++k)
     for (int j = 0; j < dims[1]; ++j)
       for (int i = 0; i < dims[0]; ++i) {
         long idx = i + long(dims[0]) * (j + long(dims[1]) * k);
         int v = int(std::lround(scalars->GetTuple1(idx)));
+        if (std::find(axis_labels.begin(), axis_labels.end(), v) != axis_labels.end())
+          voxels.emplace_back(origin[0] + i * spacing[0], origin[1] + j * spacing[1], origin[2] + k * spacing[2]);
         if (std::find(o.labels.begin(), o.labels.end(), v) == o.labels.end()) continue;
         m[(i + 1) + std::size_t(nx) * ((j + 1) + std::size_t(ny) * (k + 1))] = 1;
-        voxels.emplace_back(origin[0] + i * spacing[0], origin[1] + j * spacing[1], origin[2] + k * spacing[2]);
+        ++labelled;
       }
-  if (voxels.empty()) {
+  if (labelled == 0 || voxels.empty()) {
     std::string ls;
     for (int l : o.labels) ls += (ls.empty() ? "" : ", ") + std::to_string(l);
     throw InputError(fmt::format("{}: no voxel carries the label(s) {}", name, ls));
@@ -177,8 +181,8 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
     double e = end == 0 ? smin : smax, dir = end == 0 ? 1.0 : -1.0;
     Vector3d c0 = slab_centroid(e, e + dir * 2 * radius), c1 = slab_centroid(e + dir * 2 * radius, e + dir * 4 * radius);
     Vector3d inward = (c1 - c0).normalized();
-    double extreme = 1e300;
-    for (const auto& x : s.points) extreme = std::min(extreme, (x - c0).dot(inward));
+    double extreme = 1e300;  // outermost voxel centre: the same for every surface cut with these voxels
+    for (const auto& v : voxels) extreme = std::min(extreme, (v - c0).dot(inward));
     Vector3d plane_point = c0 + (extreme + trim) * inward;
     s = clip_by_plane(s, plane_point, -inward);
   }

@@ -205,6 +205,8 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     lo.smoothing_iterations = li->smoothing_iterations;
     lo.end_trim = li->end_trim / unit_length_in_mm(li->checks.units);  // mm → the image's units
     lo.labels = {li->lumen_label};
+    // Lumen and wall are cut by the same planes, placed by the outer region.
+    if (li->wall_label) lo.axis_labels = {li->lumen_label, *li->wall_label};
     lumen_raw = label_image_surface(li->file, lo);
     lumen_name = li->file.string() + fmt::format(" (label {})", li->lumen_label);
     if (li->wall_label) {

@@ -13,7 +13,11 @@
 #include <functional>
 
 #include "common/error.hpp"
+#include "common/config.hpp"
+#include "common/mesh_data.hpp"
+#include "common/summary.hpp"
 #include "segmentation_io/label_image.hpp"
+#include "segmentation_io/segmentation_stage.hpp"
 
 using namespace stentsim;
 using namespace stentsim::segmentation;
@@ -113,6 +117,15 @@ TEST(LabelImage, MetaImageCylinderInPhysicalCoordinates) {
     EXPECT_NE(std::string(e.what()).find("7"), std::string::npos) << e.what();
   }
   EXPECT_THROW(label_image_surface(dir / "labels.png", o), InputError);
+  // The whole stage from a case's input section: checked lumen and wall files.
+  auto cfg = ConfigMap::from_string("label_image:\n  file: " + (dir / "labels.mha").string() +
+                                        "\n  lumen_label: 1\n  wall_label: 2\n",
+                                    dir / "case.yaml");
+  SegmentationInput in = parse_segmentation_input(cfg);
+  Summary summary;
+  run_segmentation_stage(in, dir / "lumen.vtp", dir / "wall.vtp", summary);
+  TriSurface back = surface_from_mesh(read_vtp((dir / "wall.vtp").string()), "wall");
+  EXPECT_EQ(boundary_loops(back).size(), 2u);
   fs::remove_all(dir);
 }
 
