@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 
 #include "common/error.hpp"
@@ -158,5 +159,28 @@ TEST(LabelImage, NiftiQformRotatesAndTranslates) {
   EXPECT_NEAR(t.mean_r, kR, 0.02 * kR);
   EXPECT_LT(t.max_dev, 0.08);
   EXPECT_NEAR(t.volume, exact, 0.03 * exact);
+  fs::remove_all(dir);
+}
+
+TEST(LabelImage, NrrdWithAnisotropicSpacings) {
+  // VTK has no NRRD writer: a raw NRRD (header + bytes) written by hand.
+  fs::path dir = fs::temp_directory_path() / "stentsim_label_nrrd";
+  fs::create_directories(dir);
+  const double zero[3] = {0, 0, 0};
+  auto im = cylinder(zero);
+  {
+    std::ofstream f(dir / "labels.nrrd", std::ios::binary);
+    f << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << kDim[0] << " " << kDim[1] << " " << kDim[2]
+      << "\nspacings: " << kSp[0] << " " << kSp[1] << " " << kSp[2] << "\nencoding: raw\n\n";
+    f.write(static_cast<const char*>(im->GetScalarPointer()), std::streamsize(kDim[0]) * kDim[1] * kDim[2]);
+  }
+  LabelSurfaceOptions o;
+  o.labels = {1};
+  TriSurface lumen = label_image_surface(dir / "labels.nrrd", o);
+  const Vector3d a(0.5 * (kDim[0] - 1) * kSp[0], 0.5 * (kDim[1] - 1) * kSp[1], 0);
+  TubeStats t = measure(lumen, a, Vector3d::UnitZ());
+  std::printf("nrrd lumen: mean radius %.4f (rel %.2e), max deviation %.4f\n", t.mean_r, t.mean_r / kR - 1, t.max_dev);
+  EXPECT_NEAR(t.mean_r, kR, 0.02 * kR);
+  EXPECT_LT(t.max_dev, 0.08);
   fs::remove_all(dir);
 }
