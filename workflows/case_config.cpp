@@ -42,6 +42,14 @@ MeshSettings parse_mesh(ConfigMap m, meshing::GenericArterySpec& generic) {
   s.adventitia_ratio = m.number("adventitia_ratio", s.adventitia_ratio, Range::between(0, 0.5));
   s.min_intima = m.quantity("min_intima", units::kLength, s.min_intima, Range::non_negative());
   s.min_scaled_jacobian = m.number("min_scaled_jacobian", s.min_scaled_jacobian, Range::between(0, 1));
+  s.min_size_ratio = m.number("min_size_ratio", s.min_size_ratio, Range::between(0.01, 1));
+  s.intima = m.boolean("intima", s.intima);
+  s.station_spacing = m.quantity("station_spacing", units::kLength, s.station_spacing, Range::positive());
+  s.points_per_section = m.integer("points_per_section", s.points_per_section, Range::between(8, 512));
+  s.end_trim = m.quantity("end_trim", units::kLength, s.end_trim, Range::non_negative());
+  s.max_aspect_ratio = m.number("max_aspect_ratio", s.max_aspect_ratio, Range::between(1, 1e6));
+  if (s.media_ratio + s.adventitia_ratio >= 0.5) m.fail("adventitia_ratio", "media_ratio + adventitia_ratio must be below 0.5");
+  if (!s.intima && s.media_ratio == 0 && s.adventitia_ratio == 0) m.fail("intima", "at least one layer is needed");
   if (auto g = m.optional_map("generic")) {
     generic.length = g->quantity("length", units::kLength, generic.length, Range::positive());
     generic.outer_diameter = g->quantity("outer_diameter", units::kLength, generic.outer_diameter, Range::positive());

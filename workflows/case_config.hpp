@@ -9,6 +9,7 @@
 #include <string>
 
 #include "meshing/generic_artery.hpp"
+#include "meshing/patient_mesh.hpp"
 
 
 
@@ -20,14 +21,8 @@ const char* to_string(Scene s);
 /// Settings of the sections owned by the solve stage and its preprocessing
 /// (mesh, fibers, simulation, output), validated with units. Device and input
 /// sections are validated by their stages' own parsers.
-struct MeshSettings {
-  std::string element = "tet10";  // tet10 | tet4
-  double size = 0.25;             // mm, target edge length
-  int min_elements_per_layer = 2;
-  double media_ratio = 0.0786, adventitia_ratio = 0.136;  // of the local outer diameter (DESIGN §5)
-  double min_intima = 0.05;                               // mm
-  double min_scaled_jacobian = 0.1;
-};
+/// The case's `mesh:` section (patient wall mesh; `mesh.generic` is the generic artery).
+using MeshSettings = meshing::PatientMeshOptions;
 
 
 struct FiberSettings {

@@ -10,6 +10,7 @@
 #include "fibers/analytic_tube_fibers.hpp"
 #include "fibers/harmonic_fibers.hpp"
 #include "meshing/generic_artery.hpp"
+#include "meshing/patient_mesh.hpp"
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/segmentation_stage.hpp"
 
@@ -35,6 +36,23 @@ Stage generic_mesh_stage(const CaseConfig& c) {
   const meshing::GenericArterySpec spec = c.generic_artery;
   s.run = [spec](StageContext& ctx) {
     meshing::write_generic_artery(spec, ctx.output("mesh/artery.vtu").string(), ctx.summary());
+  };
+  return s;
+}
+
+/// The patient wall mesh (DESIGN.md §1): lofted layers meshed with gmsh.
+Stage patient_mesh_stage(const CaseConfig& c) {
+  Stage s;
+  s.name = "mesh";
+  s.inputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp", "centerline/centerline.vtp"};
+  s.outputs = {"mesh/artery.vtu", "mesh/artery.msh"};
+  s.config = slice(c, {"mesh"});
+  s.version = "1";
+  const meshing::PatientMeshOptions o = c.mesh;
+  s.run = [o](StageContext& ctx) {
+    meshing::run_patient_mesh(ctx.input("segmentation/lumen.vtp"), ctx.input("segmentation/wall.vtp"),
+                              ctx.input("centerline/centerline.vtp"), o, ctx.output("mesh/artery.vtu"),
+                              ctx.output("mesh/artery.msh"), ctx.summary());
   };
   return s;
 }
@@ -204,6 +222,7 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
       stages.push_back(placement_stage(c));
       stages.push_back(device_stage(c, "balloon"));
       stages.push_back(device_stage(c, "stent"));
+      stages.push_back(patient_mesh_stage(c));
       break;
   }
   // The patient's fibers need the wall mesh: added right after the stage that

@@ -10,6 +10,7 @@ void register_solve(CLI::App& app);
 void register_segmentation(CLI::App& app);
 void register_device(CLI::App& app);
 void register_fibers(CLI::App& app);
+void register_mesh(CLI::App& app);
 
 void register_all(CLI::App& app) {
   register_init(app);
@@ -17,6 +18,7 @@ void register_all(CLI::App& app) {
   register_cohort(app);
   register_segmentation(app);
   register_device(app);
+  register_mesh(app);
   register_fibers(app);
   register_solve(app);
   register_version(app);
