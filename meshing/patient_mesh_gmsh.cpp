@@ -157,7 +157,7 @@ MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, 
   gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay
   gmsh::option::setNumber("Mesh.Optimize", 1);
   gmsh::option::setNumber("Mesh.ElementOrder", o.element == "tet10" ? 2 : 1);
-  gmsh::option::setNumber("Mesh.SecondOrderLinear", 0);
+  gmsh::option::setNumber("Mesh.SecondOrderLinear", 1);  // midside nodes on straight edges: projecting them onto the lofted B-spline faces took > 10 min on case2-rca
   try {
     gmsh::model::mesh::generate(3);
   } catch (const std::exception& e) {
