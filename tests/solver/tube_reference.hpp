@@ -13,9 +13,6 @@ struct TubeReference {
 
   /// Deformed inner radius at follower pressure p.
   double inner_radius(double p) const { return study::reference::PlaneStrainTube(c, beta, ri, ro).inner_radius(p); }
-  /// Former fixed-step signature: the adaptive integrator has no step count,
-  /// so `steps` is ignored (kept for tube_test.cpp's existing call).
-  double inner_radius(double p, int /*steps*/) const { return inner_radius(p); }
 };
 
 }  // namespace stentsim::solver::test

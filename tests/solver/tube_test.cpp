@@ -69,13 +69,14 @@ std::vector<double> fe_inner_radius(int nr, int nt, const std::string& solver, s
   return radii;
 }
 
-TEST(SolverTube, ReferenceIsConverged) {
+// The reference itself (shooting with adaptive Runge-Kutta, its Lame limit)
+// is tested in tests/workflows/test_study_reference.cpp; here only its
+// small-pressure limit is checked against Lame once more with this test's
+// material, so a wrong material conversion fails here.
+TEST(SolverTube, ReferenceMatchesLameAtSmallPressure) {
   const auto nh = CoupledNeoHooke::from_young_poisson(kYoung, kNu);
   test::TubeReference ref{nh.c, nh.beta, kRi, kRo};
-  const double a = ref.inner_radius(kPmax, 2000), b = ref.inner_radius(kPmax, 4000);
-  std::printf("reference r_i(p_max) = %.12f (RK4 2000 vs 4000 steps: %.1e)\n", b, std::abs(a - b));
-  EXPECT_LT(std::abs(a - b), 1e-10);
-  // Small pressure: linear plane-strain Lame solution u(Ri) = p Ri (1+nu)/E [(1-2nu) Ri^2 + Ro^2] / (Ro^2 - Ri^2).
+  // Linear plane-strain Lame solution u(Ri) = p Ri (1+nu)/E [(1-2nu) Ri^2 + Ro^2] / (Ro^2 - Ri^2).
   const double p = 1e-6;
   const double lame = p * kRi * (1 + kNu) / kYoung * ((1 - 2 * kNu) * kRi * kRi + kRo * kRo) / (kRo * kRo - kRi * kRi);
   EXPECT_NEAR((ref.inner_radius(p) - kRi) / lame, 1.0, 1e-5);
