@@ -323,6 +323,23 @@ std::vector<std::string> command_of(const StabilityCase& c, const fs::path& inpu
   return argv;
 }
 
+/// `value` with "{suite_dir}" in its texts replaced by the suite file's folder:
+/// the case's input copy lives in its own folder, so a file beside the suite
+/// (a mesh) is named through this.
+YAML::Node with_suite_dir(const YAML::Node& value, const std::string& suite_dir) {
+  YAML::Node v = YAML::Clone(value);
+  if (v.IsScalar()) {
+    std::string t = v.Scalar();
+    for (std::size_t at; (at = t.find("{suite_dir}")) != std::string::npos;) t.replace(at, 11, suite_dir);
+    if (t != v.Scalar()) v = YAML::Node(t);
+  } else if (v.IsSequence()) {
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = with_suite_dir(v[i], suite_dir);
+  } else if (v.IsMap()) {
+    for (auto kv : v) kv.second = with_suite_dir(kv.second, suite_dir);
+  }
+  return v;
+}
+
 std::string host_line() {
   char host[256] = {0};
   ::gethostname(host, sizeof host - 1);
@@ -360,7 +377,8 @@ StabilityReport run_stability_suite(const StabilitySuite& s, const StabilityOpti
     fs::path input_copy;
     if (c.kind != StabilityCase::Kind::exec) {
       YAML::Node root = YAML::LoadFile(c.input.string());
-      for (const auto& [key, value] : c.set) set_dotted_key(root, key, value);
+      for (const auto& [key, value] : c.set)
+        set_dotted_key(root, key, with_suite_dir(value, fs::absolute(s.file).parent_path().string()));
       YAML::Emitter em;
       em << root;
       input_copy = dir / c.input.filename();

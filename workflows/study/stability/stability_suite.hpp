@@ -22,7 +22,9 @@ struct StabilityCase {
   std::string id;
   std::string subset = "all";                  ///< "quick": also in the quick subset
   std::filesystem::path input;                 ///< scene or case file (resolved)
-  std::vector<std::pair<std::string, YAML::Node>> set;  ///< dotted key -> value
+  /// dotted key -> value; "{suite_dir}" in a text value is the suite file's folder
+  /// (the input copy runs in the case's own folder, so files beside the suite need it)
+  std::vector<std::pair<std::string, YAML::Node>> set;
   std::vector<std::string> args;               ///< extra arguments (solve: e.g. --linear-solver gmres_ilu)
   std::string until;                           ///< case_file: `run --until`
   std::vector<std::string> exec;               ///< exec: the command
