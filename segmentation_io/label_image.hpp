@@ -21,7 +21,9 @@ struct LabelSurfaceOptions {
 };
 
 /// The surface of the labelled region in physical coordinates (NIfTI: the
-/// sform when set, else the qform; NRRD/MetaImage: origin and spacing). Open
+/// sform when set, else the qform; NRRD: space directions and space origin;
+/// MetaImage: TransformMatrix, ElementSpacing and Offset; without directions,
+/// origin and spacing). Open
 /// ends: the vessel's axis ends are found from the voxel centroids of slabs
 /// two and four radii in from each end, and the surface is cut by planes
 /// normal to that axis `end_trim` inside the extreme voxel centre (all from

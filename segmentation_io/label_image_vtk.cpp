@@ -17,11 +17,14 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <optional>
 #include <algorithm>
 #include <cmath>
 
 #include "common/error.hpp"
 #include "segmentation_io/branch_extraction.hpp"
+#include "segmentation_io/image_header_geometry.hpp"
 #include "segmentation_io/label_image.hpp"
 
 namespace stentsim::segmentation {
@@ -43,6 +46,7 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   vtkSmartPointer<vtkImageData> image;
   vtkSmartPointer<vtkMatrix4x4> to_world;  // NIfTI sform/qform (data coordinates → world)
+  std::optional<IndexToWorld> header_geometry;  // NRRD/MetaImage direction cosines (VTK 9.1 drops them)
   if (ends_with(lower, ".nii") || ends_with(lower, ".nii.gz")) {
     auto r = vtkSmartPointer<vtkNIFTIImageReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable NIfTI file", name));
@@ -57,12 +61,14 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
     r->SetFileName(name.c_str());
     r->Update();
     image = r->GetOutput();
+    header_geometry = nrrd_index_to_world(file);
   } else if (ends_with(lower, ".mha") || ends_with(lower, ".mhd")) {
     auto r = vtkSmartPointer<vtkMetaImageReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable MetaImage file", name));
     r->SetFileName(name.c_str());
     r->Update();
     image = r->GetOutput();
+    header_geometry = metaimage_index_to_world(file);
   } else {
     throw InputError(fmt::format("{}: unknown label image type (expected .nii, .nii.gz, .nrrd, .nhdr, .mha or .mhd)",
                                  name));
@@ -75,17 +81,38 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   double spacing[3], origin[3];
   image->GetSpacing(spacing);
   image->GetOrigin(origin);
+  // Everything below works in index space and maps to the world at the end:
+  // flying edges (vertices at edge midpoints) and windowed sinc (topological
+  // weights) commute with an affine map, so the result equals working in
+  // physical space, for any direction matrix.
+  IndexToWorld index_to_world;
+  if (header_geometry) {
+    index_to_world = *header_geometry;
+  } else {
+    index_to_world.step = Eigen::Vector3d(spacing[0], spacing[1], spacing[2]).asDiagonal();
+    index_to_world.origin = Vector3d(origin[0], origin[1], origin[2]);
+    if (to_world) {  // NIfTI: the sform/qform acts on VTK's data coordinates origin + index * spacing
+      Eigen::Matrix3d A;
+      Vector3d b;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) A(r, c) = to_world->GetElement(r, c);
+        b(r) = to_world->GetElement(r, 3);
+      }
+      index_to_world.step = A * index_to_world.step;
+      index_to_world.origin = A * index_to_world.origin + b;
+    }
+  }
   // Binary mask padded by one empty voxel on every side, so the surface closes.
   const int nx = dims[0] + 2, ny = dims[1] + 2, nz = dims[2] + 2;
   auto mask = vtkSmartPointer<vtkImageData>::New();
   mask->SetDimensions(nx, ny, nz);
-  mask->SetSpacing(spacing);
-  mask->SetOrigin(origin[0] - spacing[0], origin[1] - spacing[1], origin[2] - spacing[2]);
+  mask->SetSpacing(1, 1, 1);
+  mask->SetOrigin(-1, -1, -1);
   mask->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
   auto* m = static_cast<unsigned char*>(mask->GetScalarPointer());
   std::fill(m, m + std::size_t(nx) * ny * nz, 0);
   const std::vector<int>& axis_labels = o.axis_labels.empty() ? o.labels : o.axis_labels;
-  std::vector<Vector3d> voxels;  // data coordinates of the voxels that place the end cuts
+  std::vector<Vector3d> voxels;  // indices of the voxels that place the end cuts
   std::size_t labelled = 0;
   for (int k = 0; k < dims[2]; ++k)
     for (int j = 0; j < dims[1]; ++j)
@@ -93,7 +120,7 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
         long idx = i + long(dims[0]) * (j + long(dims[1]) * k);
         int v = int(std::lround(scalars->GetTuple1(idx)));
         if (std::find(axis_labels.begin(), axis_labels.end(), v) != axis_labels.end())
-          voxels.emplace_back(origin[0] + i * spacing[0], origin[1] + j * spacing[1], origin[2] + k * spacing[2]);
+          voxels.emplace_back(i, j, k);
         if (std::find(o.labels.begin(), o.labels.end(), v) == o.labels.end()) continue;
         m[(i + 1) + std::size_t(nx) * ((j + 1) + std::size_t(ny) * (k + 1))] = 1;
         ++labelled;
@@ -124,12 +151,7 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   tri->PassLinesOff();
   tri->Update();
   vtkPolyData* pd = tri->GetOutput();
-  auto world = [&](const Vector3d& x) -> Vector3d {
-    if (!to_world) return x;
-    double in[4] = {x.x(), x.y(), x.z(), 1.0}, out[4];
-    to_world->MultiplyPoint(in, out);
-    return {out[0], out[1], out[2]};
-  };
+  auto world = [&](const Vector3d& index) -> Vector3d { return index_to_world(index); };
   TriSurface s;
   s.points.reserve(std::size_t(pd->GetNumberOfPoints()));
   for (vtkIdType i = 0; i < pd->GetNumberOfPoints(); ++i) {
@@ -144,7 +166,7 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   while (polys->GetNextCell(npts, ids))
     if (npts == 3) s.triangles.push_back({int(ids[0]), int(ids[1]), int(ids[2])});
   if (s.triangles.empty()) throw InputError(fmt::format("{}: the labelled region gives no surface", name));
-  if (signed_volume(s) < 0)  // a mirroring sform/qform turns the triangles inside out
+  if (signed_volume(s) < 0)  // a mirroring direction matrix turns the triangles inside out
     for (auto& t : s.triangles) std::swap(t[1], t[2]);
   if (!o.open_ends) return s;
 
@@ -159,14 +181,14 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   const Vector3d axis = eig.eigenvectors().col(2);
   double smin = 1e300, smax = -1e300;
   for (const auto& v : voxels) smin = std::min(smin, (v - c).dot(axis)), smax = std::max(smax, (v - c).dot(axis));
-  const double voxel_volume = std::abs(spacing[0] * spacing[1] * spacing[2] * (to_world ? to_world->Determinant() : 1.0));
+  const double voxel_volume = std::abs(index_to_world.step.determinant());
   const double length = smax - smin;
   const double radius = std::sqrt(voxels.size() * voxel_volume / (M_PI * std::max(length, 1e-9)));
   if (length < 4 * radius)
     throw InputError(fmt::format("{}: the labelled region is {:.3g} mm long and about {:.3g} mm in radius; a vessel "
                                  "segment with two open ends should be longer than four radii",
                                  name, length, radius));
-  const double hmax = std::max({spacing[0], spacing[1], spacing[2]});
+  const double hmax = index_to_world.step.colwise().norm().maxCoeff();
   const double trim = o.end_trim > 0 ? o.end_trim : 3 * hmax + 0.5 * radius;
   auto slab_centroid = [&](double a, double b) {
     Vector3d sum = Vector3d::Zero();

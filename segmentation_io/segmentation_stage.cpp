@@ -241,9 +241,15 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     lumen_raw = std::move(seg.lumen);
     if (tr->roi_length) {
       double s0 = 0, s1 = 0;
-      lumen_raw = clip_region_of_interest(lumen_raw, seg.centerline, *tr->roi_length, s0, s1);
+      TaperedStenosis site;
+      lumen_raw = clip_region_of_interest(lumen_raw, seg.centerline, *tr->roi_length, s0, s1, &site);
       summary.set("roi_start_abscissa", s0, "mm");
       summary.set("roi_end_abscissa", s1, "mm");
+      summary.set("roi_stenosis_abscissa", site.abscissa, "mm");
+      summary.set("roi_stenosis_percent_diameter", site.percent_diameter(), "%");
+      summary.set("roi_reference_taper", site.slope);  // dr_ref/ds
+      summary.note("roi_stenosis", "narrowest radius relative to a straight reference line fitted to the radius's upper "
+                                   "envelope (discounts the vessel taper)");
     }
     lumen_name = tr->file.string() + " (extracted segment)";
     checks.units = "mm";  // already scaled

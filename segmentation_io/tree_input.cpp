@@ -63,8 +63,44 @@ Vector3d farthest_point_along_surface(const TriSurface& tree, const Vector3d& fr
   return s.points[far] - inset * sign * normal[far].normalized();
 }
 
+TaperedStenosis stenosis_discounting_taper(const std::vector<double>& S, const std::vector<double>& R, double lo,
+                                           double hi) {
+  std::vector<std::size_t> inner;
+  for (std::size_t i = 0; i < S.size() && i < R.size(); ++i)
+    if (S[i] >= lo && S[i] <= hi) inner.push_back(i);
+  if (inner.size() < 3) throw ComputeError("stenosis site: fewer than three centerline samples between the ends");
+  // Upper-envelope line: refit on the samples not below the last line by more than 2 % of its mean.
+  double a = 0, b = 0;  // r_ref(s) = a + b s
+  std::vector<std::size_t> use = inner;
+  for (int pass = 0; pass < 8; ++pass) {
+    double n = 0, ss = 0, sr = 0, sss = 0, ssr = 0;
+    for (std::size_t i : use) n += 1, ss += S[i], sr += R[i], sss += S[i] * S[i], ssr += S[i] * R[i];
+    const double det = n * sss - ss * ss;
+    b = det > 1e-12 * n * sss ? (n * ssr - ss * sr) / det : 0.0;
+    a = (sr - b * ss) / n;
+    double mean = 0;
+    for (std::size_t i : inner) mean += a + b * S[i];
+    mean /= double(inner.size());
+    std::vector<std::size_t> next;
+    for (std::size_t i : inner)
+      if (R[i] >= a + b * S[i] - 0.02 * mean) next.push_back(i);
+    if (next.size() < 2 || next == use) break;
+    use = next;
+  }
+  TaperedStenosis t;
+  t.slope = b;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i : inner) {
+    const double ref = a + b * S[i];
+    if (ref <= 0) continue;
+    if (R[i] / ref < best) best = R[i] / ref, t.abscissa = S[i], t.radius = R[i], t.reference_radius = ref;
+  }
+  if (!std::isfinite(best)) throw ComputeError("stenosis site: the fitted reference radius is not positive");
+  return t;
+}
+
 TriSurface clip_region_of_interest(const TriSurface& lumen, const CenterlineResult& cl, double length, double& s0,
-                                   double& s1) {
+                                   double& s1, TaperedStenosis* site_out) {
   const auto& P = cl.centerline.points;
   const auto& S = cl.centerline.point_data.at("Abscissas").values;
   const auto& R = cl.centerline.point_data.at("MaximumInscribedSphereRadius").values;
@@ -74,7 +110,10 @@ TriSurface clip_region_of_interest(const TriSurface& lumen, const CenterlineResu
   if (hi - lo < length)
     throw InputError(fmt::format("region of interest: {:.3g} mm asked, but the vessel segment offers {:.3g} mm between "
                                  "its ends (less a radius at each)", length, std::max(0.0, hi - lo)));
-  s0 = std::clamp(cl.stenosis_abscissa - 0.5 * length, lo, hi - length);
+  // The site discounting the taper (the narrowest radius may be the healthy distal end).
+  const TaperedStenosis site = stenosis_discounting_taper(S, R, lo, hi);
+  if (site_out) *site_out = site;
+  s0 = std::clamp(site.abscissa - 0.5 * length, lo, hi - length);
   s1 = s0 + length;
   auto frame = [&](double s, Vector3d& p, Vector3d& t) {
     std::size_t i = 1;
@@ -87,13 +126,15 @@ TriSurface clip_region_of_interest(const TriSurface& lumen, const CenterlineResu
   frame(s0, p0, t0);
   frame(s1, p1, t1);
   TriSurface cut = clip_by_plane(clip_by_plane(lumen, p0, -t0), p1, t1);
+  Vector3d site_point, site_tangent;
+  frame(site.abscissa, site_point, site_tangent);
   // A curved vessel may cross a cut plane again elsewhere: keep the piece at the stenosis.
   auto parts = connected_pieces(cut);
   std::size_t best = 0;
   double bd = std::numeric_limits<double>::max();
   for (std::size_t i = 0; i < parts.size(); ++i) {
     SurfaceDistance d(parts[i]);
-    double dist = d.distance(cl.stenosis_point);
+    double dist = d.distance(site_point);
     if (dist < bd) bd = dist, best = i;
   }
   return parts[best];

@@ -12,6 +12,9 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <sstream>
+
+#include <Eigen/Geometry>
 
 #include "common/error.hpp"
 #include "common/config.hpp"
@@ -182,5 +185,108 @@ TEST(LabelImage, NrrdWithAnisotropicSpacings) {
   std::printf("nrrd lumen: mean radius %.4f (rel %.2e), max deviation %.4f\n", t.mean_r, t.mean_r / kR - 1, t.max_dev);
   EXPECT_NEAR(t.mean_r, kR, 0.02 * kR);
   EXPECT_LT(t.max_dev, 0.08);
+  fs::remove_all(dir);
+}
+
+namespace {
+
+// An oblique rotation: 40 degrees about (1, 2, 2)/3.
+Eigen::Matrix3d oblique_rotation() {
+  return Eigen::AngleAxisd(40.0 * M_PI / 180.0, Vector3d(1, 2, 2).normalized()).toRotationMatrix();
+}
+
+// The cylinder's axis in the world: through index (cx, cy, 0) along index axis k.
+void expect_tube_along(const TriSurface& lumen, const Eigen::Matrix3d& step, const Vector3d& origin, const char* what) {
+  const Vector3d a = origin + step * Vector3d(0.5 * (kDim[0] - 1), 0.5 * (kDim[1] - 1), 0);
+  const Vector3d d = step.col(2).normalized();
+  TubeStats t = measure(lumen, a, d);
+  const double exact = M_PI * kR * kR * t.length;
+  std::printf("%s lumen: mean radius %.4f (rel %.2e), max deviation %.4f, length %.3f, volume rel %.2e\n", what,
+              t.mean_r, t.mean_r / kR - 1, t.max_dev, t.length, t.volume / exact - 1);
+  EXPECT_NEAR(t.mean_r, kR, 0.02 * kR) << what;
+  EXPECT_LT(t.max_dev, 0.08) << what;
+  EXPECT_NEAR(t.volume, exact, 0.03 * exact) << what;  // positive: outward normals even for a mirroring matrix
+}
+
+}  // namespace
+
+// NRRD "space directions" (oblique, anisotropic) and "space origin": VTK 9.1's
+// reader drops the rotation; the surface must come out along the rotated axis.
+TEST(LabelImage, NrrdSpaceDirectionsRotateTheSurface) {
+  fs::path dir = fs::temp_directory_path() / "stentsim_label_nrrd_dir";
+  fs::create_directories(dir);
+  const double zero[3] = {0, 0, 0};
+  auto im = cylinder(zero);
+  const Eigen::Matrix3d step = oblique_rotation() * Vector3d(kSp[0], kSp[1], kSp[2]).asDiagonal();
+  const Vector3d origin(12.5, -40.0, 7.25);
+  {
+    std::ofstream f(dir / "labels.nrrd", std::ios::binary);
+    f.precision(17);
+    f << "NRRD0005\n# oblique acquisition\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\nsizes: " << kDim[0]
+      << " " << kDim[1] << " " << kDim[2] << "\nspace directions:";
+    for (int a = 0; a < 3; ++a) f << " (" << step(0, a) << "," << step(1, a) << "," << step(2, a) << ")";
+    f << "\nkinds: domain domain domain\nencoding: raw\nspace origin: (" << origin.x() << "," << origin.y() << ","
+      << origin.z() << ")\n\n";
+    f.write(static_cast<const char*>(im->GetScalarPointer()), std::streamsize(kDim[0]) * kDim[1] * kDim[2]);
+  }
+  LabelSurfaceOptions o;
+  o.labels = {1};
+  expect_tube_along(label_image_surface(dir / "labels.nrrd", o), step, origin, "nrrd oblique");
+
+  // A header with two directions for a 3-D image names the field.
+  {
+    std::ofstream f(dir / "bad.nrrd", std::ios::binary);
+    f << "NRRD0005\ntype: uint8\ndimension: 3\nsizes: " << kDim[0] << " " << kDim[1] << " " << kDim[2]
+      << "\nspace dimension: 3\nspace directions: (0.1,0,0) (0,0.08,0) none\nencoding: raw\n\n";
+    f.write(static_cast<const char*>(im->GetScalarPointer()), std::streamsize(kDim[0]) * kDim[1] * kDim[2]);
+  }
+  try {
+    label_image_surface(dir / "bad.nrrd", o);
+    ADD_FAILURE() << "no error for two space directions";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.nrrd: space directions"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("expected three 3-vectors"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+// MetaImage TransformMatrix (rows: unit direction of each index axis, as ITK
+// writes it) with a mirroring matrix (determinant -1), ElementSpacing and Offset.
+TEST(LabelImage, MetaImageTransformMatrixRotatesAndMirrors) {
+  fs::path dir = fs::temp_directory_path() / "stentsim_label_mha_dir";
+  fs::create_directories(dir);
+  const double zero[3] = {0, 0, 0};
+  auto im = cylinder(zero);
+  Eigen::Matrix3d directions = oblique_rotation();  // columns: axis directions
+  directions.col(0) = -directions.col(0);           // mirror
+  const Eigen::Matrix3d step = directions * Vector3d(kSp[0], kSp[1], kSp[2]).asDiagonal();
+  const Vector3d origin(-3.0, 22.0, 101.5);
+  auto write = [&](const fs::path& p, const std::string& matrix_line) {
+    std::ofstream f(p, std::ios::binary);
+    f.precision(17);
+    f << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\nCompressedData = False\n"
+      << matrix_line << "\nOffset = " << origin.x() << " " << origin.y() << " " << origin.z()
+      << "\nCenterOfRotation = 0 0 0\nAnatomicalOrientation = RAI\nElementSpacing = " << kSp[0] << " " << kSp[1] << " "
+      << kSp[2] << "\nDimSize = " << kDim[0] << " " << kDim[1] << " " << kDim[2]
+      << "\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n";
+    f.write(static_cast<const char*>(im->GetScalarPointer()), std::streamsize(kDim[0]) * kDim[1] * kDim[2]);
+  };
+  std::ostringstream m;
+  m.precision(17);
+  m << "TransformMatrix =";
+  for (int a = 0; a < 3; ++a)
+    for (int c = 0; c < 3; ++c) m << " " << directions(c, a);
+  write(dir / "labels.mha", m.str());
+  LabelSurfaceOptions o;
+  o.labels = {1};
+  expect_tube_along(label_image_surface(dir / "labels.mha", o), step, origin, "mha mirrored oblique");
+
+  write(dir / "bad.mha", "TransformMatrix = 2 0 0 0 1 0 0 0 1");
+  try {
+    label_image_surface(dir / "bad.mha", o);
+    ADD_FAILURE() << "no error for a non-unit TransformMatrix row";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.mha: TransformMatrix: row 1"), std::string::npos) << e.what();
+  }
   fs::remove_all(dir);
 }
