@@ -17,6 +17,8 @@
 #include "solver/beams/beam_output.hpp"
 #include "solver/beams/beam_term.hpp"
 #include "solver/beams/direction_constraint.hpp"
+#include "solver/beams/radial_release.hpp"
+#include "solver/beams/rigid_joints.hpp"
 #include "solver/beams/rotation.hpp"
 #include "solver/io/results_writer.hpp"
 #include "solver/io/scene.hpp"
@@ -69,8 +71,20 @@ struct Built {
   std::map<std::string, const beams::BeamBodyDesc*> beam_desc;
   std::map<std::string, Eigen::Vector3d> tip_rotation;      // accumulated rotation vector per QoI name
   std::vector<std::pair<std::string, FollowerPressure*>> pressures;
+  std::map<std::string, beams::RadialDisplacementTerm*> radial;  // radial_displacement conditions by name
   std::vector<std::string> notes;
 };
+
+/// Cylindrical frame (e_r, e_φ, axis) of a point about an axis.
+Mat3 cylindrical_frame(const Vec3& x, const Vec3& origin, const Vec3& axis) {
+  const Vec3 d = x - origin;
+  Vec3 er = d - d.dot(axis) * axis;
+  if (er.norm() < 1e-12) throw InputError("a node lies on the axis; its radial direction is undefined");
+  er.normalize();
+  Mat3 q;
+  q.col(0) = er, q.col(1) = axis.cross(er), q.col(2) = axis;
+  return q;
+}
 
 // Clamp, dead point force/moment and "moves only along a direction" on beam nodes.
 void add_beam_condition(const SceneDesc& scene, const ConditionDesc& c, Built& out,
@@ -78,9 +92,53 @@ void add_beam_condition(const SceneDesc& scene, const ConditionDesc& c, Built& o
   Model& model = out.model;
   beams::BeamTerm& beam = *out.beams.at(c.body);
   const beams::BeamBodyDesc& desc = *out.beam_desc.at(c.body);
-  const auto nodes = beams::select_beam_nodes(desc, c.node);
+  const std::string file = scene.file.string();
   const LoadCurve curve = c.curve.empty() ? LoadCurve() : scene.curves.at(c.curve);
+  if (c.type == ConditionDesc::Type::release) {
+    // The radial condition (read before, scene.cpp) turns into its reactions × curve after `at`.
+    const double tol = 1e-9 * std::max(1.0, std::abs(scene.stepping.t_end));
+    out.radial.at(c.release_from)->set_release(c.release_at, [curve](double t) { return curve(t); }, tol);
+    log::info("condition '{}': '{}' becomes point forces equal to its reactions at t = {:g}, × curve '{}'", c.name,
+              c.release_from, c.release_at, c.curve);
+    return;
+  }
+  const auto nodes = beams::select_beam_nodes(desc, c.node);
   log::info("condition '{}': {} node(s) of beam body '{}' ({})", c.name, nodes.size(), c.body, c.node.describe());
+  // A condition on a joint acts on its master node; on a slave node it is an error.
+  if (!desc.joint_map.master.empty())
+    for (int n : nodes) beams::require_master_node(desc.joint_map, n, fmt::format("{}: condition '{}'", file, c.name));
+  if (c.type == ConditionDesc::Type::radial_displacement) {
+    std::vector<beams::RadialDisplacementTerm::Node> rn;
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const int n = nodes[k];
+      beams::RadialDisplacementTerm::Node x;
+      x.pos = beam.dofs()[static_cast<std::size_t>(n)].pos;
+      try {
+        x.radial = cylindrical_frame(desc.body.nodes[static_cast<std::size_t>(n)].position, c.axis_origin, c.axis).col(0);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: condition '{}': node {}: {}", file, c.name, n, e.what()));
+      }
+      x.multiplier = multipliers.at(c.name) + static_cast<GlobalDof>(k);
+      rn.push_back(x);
+    }
+    out.radial[c.name] = &model.add_term<beams::RadialDisplacementTerm>(c.name, std::move(rn), c.value,
+                                                                          [curve](double t) { return curve(t); });
+    return;
+  }
+  if (c.type == ConditionDesc::Type::fix_cylindrical) {
+    for (int n : nodes) {
+      const beams::BeamNodeDofs& d = beam.dofs()[static_cast<std::size_t>(n)];
+      if (d.pos[0] < 0 || d.pos[1] != d.pos[0] + 1 || d.pos[2] != d.pos[0] + 2)
+        throw std::logic_error("beam position DOFs are not a consecutive triple");
+      const Mat3 q = cylindrical_frame(desc.body.nodes[static_cast<std::size_t>(n)].position, c.axis_origin, c.axis);
+      if (const Mat3* old = model.constraints.frame(d.pos[0]); old && (*old - q).norm() > 1e-12)
+        throw InputError(fmt::format("{}: condition '{}': node {} already has another nodal frame (another axis)", file,
+                                     c.name, n));
+      model.constraints.set_frame(d.pos[0], q);
+      for (int comp : c.components) model.constraints.fix(d.pos[0] + comp, [](double) { return 0.0; });
+    }
+    return;
+  }
   std::size_t k = 0;
   for (int n : nodes) {
     const beams::BeamNodeDofs& d = beam.dofs()[static_cast<std::size_t>(n)];
@@ -123,21 +181,32 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
   for (const auto& b : scene.bodies) {
     if (b.beam) {
       // Beam DOFs from the model's DOF map: 9 per Hermite end node, 3 per middle node, 6 per Lagrange node.
+      // Rigid joints (stent files): slaves share their master's position and rotation DOFs (rigid_joints.hpp).
       const beams::BeamBodyDefinition& def = b.beam->body;
-      const GlobalDof count = beams::beam_nodal_dof_count(def);
+      const GlobalDof nodal = beams::beam_nodal_dof_count(def);
+      GlobalDof count = 0;
+      b.beam->number_dofs(0, &count);
       const GlobalDof first = model.dofs.allocate(b.name, count);
       GlobalDof next = 0;
-      auto dofs = beams::number_beam_dofs(def, first, &next);
+      auto dofs = b.beam->number_dofs(first, &next);
       if (next != first + count) throw std::logic_error("beam DOF numbering does not match its count");
       out->beams[b.name] = &model.add_term<beams::BeamTerm>(b.name, def, std::move(dofs));
       out->beam_desc[b.name] = &*b.beam;
-      out->notes.push_back(fmt::format("beam body {}: {} elements, {} nodal DOFs ({})", b.name, def.elements.size(), count,
-                                       b.beam->source));
-      log::info("beam body '{}': {} elements, {} nodes, {} nodal DOFs ({})", b.name, def.elements.size(), def.nodes.size(),
-                count, b.beam->source);
-      if (!b.beam->joints.empty())
-        log::warn("beam body '{}': {} joints in the file are not coupled (joint coupling: issue 8 part 2)", b.name,
-                  b.beam->joints.size());
+      const std::string joints = b.beam->joint_map.master.empty()
+                                     ? (b.beam->joints.empty() ? std::string("no joints")
+                                                               : fmt::format("{} joints not coupled (joints: none)", b.beam->joints.size()))
+                                     : fmt::format("{} rigid joints, {} DOFs after coupling", b.beam->joints.size(), count);
+      const std::string law = def.section.plastic
+                                  ? fmt::format("elasto-plastic bending E {:g}, G {:g}, E_ep {:g} MPa, M_y0 {:g} N mm, R {:g} mm",
+                                                def.section.plastic->E, def.section.plastic->G, def.section.plastic->E_ep,
+                                                def.section.plastic->M_y0, def.section.plastic->radius)
+                                  : std::string("elastic");
+      out->notes.push_back(fmt::format("beam body {}: {} elements, {} nodal DOFs, {}; {} ({})", b.name, def.elements.size(),
+                                       nodal, joints, law, b.beam->source));
+      log::info("beam body '{}': {} elements, {} nodes, {} nodal DOFs, {}; {} ({})", b.name, def.elements.size(),
+                def.nodes.size(), nodal, joints, law, b.beam->source);
+      if (!b.beam->joints.empty() && b.beam->joint_map.master.empty())
+        log::warn("beam body '{}': {} joints in the file are not coupled (joints: none)", b.name, b.beam->joints.size());
       continue;
     }
     SolidBodySpec spec;
@@ -179,9 +248,10 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
   // Lagrange multipliers of "moves only along a direction" (their own DOFs, before constraints are sized).
   std::map<std::string, GlobalDof> multipliers;  // condition name -> first multiplier DOF
   for (const auto& c : scene.conditions) {
-    if (c.type != ConditionDesc::Type::direction) continue;
+    if (c.type != ConditionDesc::Type::direction && c.type != ConditionDesc::Type::radial_displacement) continue;
     const auto nodes = beams::select_beam_nodes(*out->beam_desc.at(c.body), c.node);
-    multipliers[c.name] = model.dofs.allocate(c.name, 2 * static_cast<GlobalDof>(nodes.size()));
+    const GlobalDof per_node = c.type == ConditionDesc::Type::direction ? 2 : 1;
+    multipliers[c.name] = model.dofs.allocate(c.name, per_node * static_cast<GlobalDof>(nodes.size()));
   }
   model.size_constraints();
   std::map<GlobalDof, std::string> framed, globally_fixed;  // node first DOF -> condition name
@@ -241,6 +311,42 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
     }
   }
   return out;
+}
+
+// ring_expansion QoI (scene.hpp): values kept in one vector so that checkpoints carry them.
+enum RingSlot { kDmax, kMbPeak, kDend, kMbEnd, kExternalWork, kStoredEnd, kPlasticWorkEnd, kD0, kRingSlots };
+
+double ring_diameter(const QoiDesc& q, const Built& b, const Eigen::VectorXd& u) {
+  const beams::BeamTerm& beam = *b.beams.at(q.body);
+  const auto nodes = beams::select_beam_nodes(*b.beam_desc.at(q.body), q.node);
+  double acc = 0.0;
+  for (int n : nodes) {
+    const Vec3 d = beam.position(u, n) - q.axis_origin;
+    acc += (d - d.dot(q.axis) * q.axis).norm();
+  }
+  return 2.0 * acc / static_cast<double>(nodes.size());
+}
+
+/// Largest ‖M_b‖ over every Gauss point of the body at u (committed history).
+double max_bending_moment(const beams::BeamTerm& beam, const Eigen::VectorXd& u) {
+  double m = 0.0;
+  for (std::size_t e = 0; e < beam.body().elements.size(); ++e)
+    for (const auto& st : beam.section_states(u, e)) m = std::max(m, st.M.tail<2>().norm());
+  return m;
+}
+
+/// Radial force on the body (−λ) and radial displacement of every radial_displacement node,
+/// for the external work (the other conditions hold zero displacement components: no work).
+std::vector<std::pair<double, double>> radial_snapshot(const Built& b, const Eigen::VectorXd& u) {
+  std::vector<std::pair<double, double>> s;
+  for (const auto& [name, t] : b.radial)
+    for (std::size_t k = 0; k < t->nodes().size(); ++k) {
+      const auto& n = t->nodes()[k];
+      double ur = 0.0;
+      for (int i = 0; i < 3; ++i) ur += n.pos[i] >= 0 ? n.radial[i] * u[n.pos[i]] : 0.0;
+      s.emplace_back(-t->multiplier(u, k), ur);
+    }
+  return s;
 }
 
 int qoi_beam_node(const QoiDesc& q, const Built& b) {
@@ -364,6 +470,13 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   } else {
     frame(scene.stepping.t_start);
   }
+  // ring_expansion: the radial forces and displacements of the last converged state (external work).
+  std::vector<std::pair<double, double>> ring_last = radial_snapshot(*built, u);
+  for (const auto& q : scene.qois)
+    if (q.type == QoiDesc::Type::ring_expansion && !qoi.count(q.name)) {
+      qoi[q.name].assign(kRingSlots, 0.0);
+      qoi[q.name][kD0] = ring_diameter(q, *built, u);
+    }
   std::vector<std::string> columns{"step", "time", "dt", "load_factor", "newton_iterations", "linear_iterations", "step_cuts",
                                    "wall_time_s", "assembly_s", "linear_solve_s"};
   for (const auto& [name, p] : built->pressures) columns.push_back("pressure_" + name);
@@ -385,8 +498,23 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
     for (double s : scene.stepping.stops) at_stop = at_stop || std::abs(r.time - s) < tol;
     if (r.step % scene.output_every == 0 || at_stop) frame(r.time);
     track_tip_rotations(scene, *built);
-    for (const auto& q : scene.qois)
+    for (const auto& q : scene.qois) {
+      if (q.type == QoiDesc::Type::ring_expansion) {
+        // External work by trapezoidal rule over the step; D and max ‖M_b‖ at the peak and the end.
+        auto& v = qoi[q.name];
+        v.resize(kRingSlots, 0.0);
+        const auto now = radial_snapshot(*built, u);
+        for (std::size_t k = 0; k < now.size() && k < ring_last.size(); ++k)
+          v[kExternalWork] += 0.5 * (now[k].first + ring_last[k].first) * (now[k].second - ring_last[k].second);
+        ring_last = now;
+        const beams::BeamTerm& beam = *built->beams.at(q.body);
+        if (std::abs(r.time - q.time) < tol) v[kDmax] = ring_diameter(q, *built, u), v[kMbPeak] = max_bending_moment(beam, u);
+        v[kDend] = ring_diameter(q, *built, u), v[kMbEnd] = max_bending_moment(beam, u);
+        v[kStoredEnd] = beam.energy(u), v[kPlasticWorkEnd] = beam.plastic_work();
+        continue;
+      }
       if (std::abs(r.time - q.time) < tol) qoi[q.name] = qoi_values(q, *built, u);
+    }
     if (scene.checkpoint_every > 0 && r.step % scene.checkpoint_every == 0 && writes) {
       HistoryArchive ck;
       ck.put("solver/u", std::span<const double>(u.data(), static_cast<std::size_t>(u.size())));
@@ -402,6 +530,13 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
       log::info("checkpoint at step {} (t = {:.6g}): {}", r.step, r.time, checkpoint_file.string());
     }
   };
+  // The stall message names the load the run could not go beyond (issue 11: "no converged state beyond p = ...").
+  scene.stepping.describe_load = [&](double t) {
+    std::string d;
+    for (const auto& [name, p] : built->pressures) d += fmt::format("{}p = {:.6g} MPa", d.empty() ? "" : ", ", p->pressure(t));
+    if (d.empty()) d = fmt::format("t = {:.6g}", t);
+    return fmt::format("{} (load factor {:.6g}, t = {:.6g})", d, lf ? (*lf)(t) : t, t);
+  };
   GlobalSystem system(model.constraints);
   int status = 0;
   std::string failure;
@@ -416,6 +551,21 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   }
   for (const auto& q : scene.qois) {
     if (!qoi.count(q.name)) continue;
+    if (q.type == QoiDesc::Type::ring_expansion) {
+      const auto& v = qoi[q.name];
+      summary.set("D_initial", v[kD0], "mm");
+      summary.set("D_max", v[kDmax], "mm");
+      summary.set("D_end", v[kDend], "mm");
+      summary.set("recoil_percent", v[kDmax] > 0 ? 100.0 * (v[kDmax] - v[kDend]) / v[kDmax] : 0.0, "%");
+      summary.set("max_bending_moment_peak", v[kMbPeak], "N mm");
+      summary.set("max_bending_moment_end", v[kMbEnd], "N mm");
+      summary.set("external_work", v[kExternalWork], "N mm");
+      summary.set("stored_energy_end", v[kStoredEnd], "N mm");
+      summary.set("plastic_work_end", v[kPlasticWorkEnd], "N mm");
+      const double W = v[kExternalWork];
+      summary.set("energy_balance_error", W != 0 ? std::abs(W - v[kStoredEnd] - v[kPlasticWorkEnd]) / std::abs(W) : 0.0);
+      continue;
+    }
     if (q.type == QoiDesc::Type::tip_position) summary.set(q.name, qoi[q.name], "mm");
     else summary.set(q.name, qoi[q.name][0], q.type == QoiDesc::Type::tip_rotation_angle ? "rad" : "mm");
   }

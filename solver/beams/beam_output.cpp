@@ -21,6 +21,15 @@ MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int sa
   DataArray &radius = arr("Radius", 1), &d1 = arr("TriadD1", 3), &d2 = arr("TriadD2", 3), &d3 = arr("TriadD3", 3);
   DataArray &axial = arr("AxialForce", 1), &shear = arr("ShearForce", 2), &torsion = arr("TorsionalMoment", 1);
   DataArray &bending = arr("BendingMoment", 1), &stress = arr("OuterFibreStress", 1), &disp = arr("Displacement", 3);
+  // Elasto-plastic sections (App. C): the committed history of the nearest
+  // Gauss point (BeamTerm::sample), the outer-fibre plastic strain R·‖Ω_pl‖
+  // and whether the section is on the yield surface (‖M_b‖ ≥ (1 − 1e-6)·M_y,
+  // M_y = M_y0 + H·I·Ω̄_pl, after some plastic flow: yielding or at yield).
+  const bool plastic = sec.plastic.has_value();
+  DataArray* kpl = plastic ? &arr("PlasticCurvature", 3) : nullptr;
+  DataArray* kacc = plastic ? &arr("AccumulatedPlasticCurvature", 1) : nullptr;
+  DataArray* eps = plastic ? &arr("OuterFibrePlasticStrain", 1) : nullptr;
+  DataArray* yielding = plastic ? &arr("Yielding", 1) : nullptr;
   DataArray& element_id = m.cell_data["ElementId"];
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(u.size());
   for (std::size_t e = 0; e < beam.body().elements.size(); ++e) {
@@ -45,11 +54,20 @@ MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int sa
       torsion.values.push_back(s.M[0]);
       bending.values.push_back(Mb);
       stress.values.push_back((A > 0 ? std::abs(s.F[0]) / A : 0.0) + (I > 0 ? Mb * R / I : 0.0));
+      if (plastic) {
+        const PlasticBendingLaw& law = *sec.plastic;
+        for (int c = 0; c < 3; ++c) kpl->values.push_back(s.plastic.plastic_curvature[c]);
+        kacc->values.push_back(s.plastic.accumulated);
+        eps->values.push_back(law.radius * s.plastic.plastic_curvature.norm());
+        const double My = law.M_y0 + law.hardening_modulus() * law.inertia() * s.plastic.accumulated;
+        yielding->values.push_back(s.plastic.accumulated > 0.0 && Mb >= (1.0 - 1e-6) * My ? 1.0 : 0.0);
+      }
     }
     m.add_cell(CellType::polyline, ids);
     element_id.values.push_back(static_cast<double>(e));
   }
   m.field_text["units"] = "mm, N, MPa";
+  if (plastic) m.field_text["plastic_curvature"] = "material components (d1, d2, d3) of the section frame, 1/mm";
   m.field_text["beam_resultants"] = "material frame: F = C_F Gamma, M = C_M Omega (Simo-Reissner)";
   return m;
 }

@@ -10,6 +10,12 @@
 //   BendingMoment     ‖M_b‖ = √(M₂² + M₃²)       [N·mm]
 //   OuterFibreStress  |N|/A + ‖M_b‖ R / I        [MPa]
 //   Displacement      r − r₀                     [mm]
+// and, for elasto-plastic sections (App. C), from the committed history of the
+// nearest Gauss point:
+//   PlasticCurvature             Ω_pl, material components   [1/mm]
+//   AccumulatedPlasticCurvature  Ω̄_pl                        [1/mm]
+//   OuterFibrePlasticStrain      R·‖Ω_pl‖                    [-]
+//   Yielding                     1 on the yield surface after plastic flow, else 0
 // and cell data ElementId. Section resultants are the material (convected)
 // ones, F = C_F Γ, M = C_M Ω, components in the section triad.
 #include "common/mesh_data.hpp"

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -64,12 +65,64 @@ BeamSection read_section(ConfigMap& beam, double E, double G) {
 
 }  // namespace
 
+namespace {
+
+// The material of a beam body: E, G and optionally the plastic bending law
+// (`material: stent` or `plastic: {E_ep, M_y0}`; the radius is set later).
+struct BeamMaterial {
+  double E = 0, G = 0;
+  std::optional<PlasticBendingLaw> plastic;
+};
+
+BeamMaterial read_beam_material(ConfigMap& beam) {
+  BeamMaterial m;
+  if (beam.has("material")) {
+    beam.choice("material", {"stent"});
+    if (beam.has("E") || beam.has("G") || beam.has("plastic"))
+      beam.fail("material", "the stent preset sets E, G and the plastic law; remove E, G and plastic");
+    m.plastic = PlasticBendingLaw::stent_preset();
+    m.E = m.plastic->E, m.G = m.plastic->G;
+    return m;
+  }
+  m.E = beam.quantity("E", units::kPressure, std::nullopt, Range::positive());
+  m.G = beam.quantity("G", units::kPressure, std::nullopt, Range::positive());
+  if (auto p = beam.optional_map("plastic")) {
+    PlasticBendingLaw law;
+    law.E = m.E, law.G = m.G;
+    law.E_ep = p->quantity("E_ep", units::kPressure, std::nullopt, Range::positive());
+    law.M_y0 = p->number("M_y0", std::nullopt, Range::positive());  // N mm
+    if (law.E_ep >= m.E) p->fail("E_ep", "the elasto-plastic modulus must be below E");
+    p->finish();
+    m.plastic = law;
+  }
+  return m;
+}
+
+// Elasto-plastic bending needs a circular section (App. C; DESIGN.md §8).
+void make_plastic(BeamBodyDesc& d, const BeamMaterial& m, ConfigMap& beam) {
+  if (!m.plastic) return;
+  BeamSection& sec = d.body.section;
+  if (!(sec.radius > 0.0))
+    beam.fail(beam.has("material") ? "material" : "plastic", "elasto-plastic bending needs a circular section ({radius: R})");
+  PlasticBendingLaw law = *m.plastic;
+  law.radius = sec.radius;
+  law.validate((beam.file().string() + ": " + beam.dotted_path()).c_str());
+  sec = BeamSection::circular_plastic(law);
+}
+
+}  // namespace
+
+std::vector<BeamNodeDofs> BeamBodyDesc::number_dofs(GlobalDof first, GlobalDof* next) const {
+  if (joint_map.master.empty()) return number_beam_dofs(body, first, next);
+  return number_joined_beam_dofs(body, joint_map, first, next);
+}
+
 BeamBodyDesc read_beam_body(ConfigMap& beam) {
   BeamBodyDesc d;
   const bool has_file = beam.has("file"), has_gen = beam.has("generate");
   if (has_file == has_gen) beam.fail("", "give exactly one of 'file' (the stent stage's stent.vtu) or 'generate'");
-  const double E = beam.quantity("E", units::kPressure, std::nullopt, Range::positive());
-  const double G = beam.quantity("G", units::kPressure, std::nullopt, Range::positive());
+  const BeamMaterial mat = read_beam_material(beam);
+  const double E = mat.E, G = mat.G;
   const std::string where = beam.file().string() + ": " + beam.dotted_path();
   if (has_file) {
     const auto path = beam.path("file");
@@ -90,8 +143,18 @@ BeamBodyDesc read_beam_body(ConfigMap& beam) {
     d.fixations = std::move(s.fixations);
     d.source = path.string();
     d.body.gauss_points = beam.integer("gauss_points", 0, Range::between(0, 10));
+    make_plastic(d, mat, beam);
+    d.couple_joints = beam.choice("joints", {"rigid", "none"}, "rigid") == "rigid";
+    if (d.couple_joints && !d.joints.empty()) {
+      try {
+        d.joint_map = make_joint_map(d.body, d.joints, path.string());
+      } catch (const InputError& e) {
+        beam.fail("file", e.what());
+      }
+    }
     return d;
   }
+  if (beam.has("joints")) beam.fail("joints", "generated bodies have no joints (joints come from a stent file)");
   const std::string interp = beam.choice("interpolation", {"hermite3", "lagrange2"}, "hermite3");
   const BeamInterpolation kind = interp == "hermite3" ? BeamInterpolation::hermite3 : BeamInterpolation::lagrange2;
   ConfigMap g = beam.map("generate");
@@ -142,6 +205,7 @@ BeamBodyDesc read_beam_body(ConfigMap& beam) {
   d.body.section = read_section(beam, E, G);
   d.body.section.validate(where);
   d.body.gauss_points = beam.integer("gauss_points", 0, Range::between(0, 10));
+  make_plastic(d, mat, beam);
   return d;
 }
 
@@ -150,6 +214,12 @@ std::string BeamNodeSelector::describe() const {
     case Kind::first: return "first";
     case Kind::last: return "last";
     case Kind::fixations: return "fixations";
+    case Kind::joints: return "joints";
+    case Kind::index: {
+      std::string t = "index [";
+      for (std::size_t i = 0; i < indices.size(); ++i) t += (i ? ", " : "") + std::to_string(indices[i]);
+      return t + "]";
+    }
     case Kind::point: return fmt::format("point ({:g}, {:g}, {:g})", point.x(), point.y(), point.z());
   }
   return "?";
@@ -157,15 +227,28 @@ std::string BeamNodeSelector::describe() const {
 
 BeamNodeSelector read_beam_node_selector(ConfigMap& cfg, const std::string& key) {
   BeamNodeSelector s;
-  if (!cfg.has(key)) cfg.fail(key, "expected a beam node: first, last, fixations or {point: [x, y, z]}");
+  if (!cfg.has(key)) cfg.fail(key, "expected a beam node: first, last, fixations, joints, {point: [x, y, z]} or {index: [n]}");
   if (cfg.node()[key].IsScalar()) {
-    const std::string w = cfg.choice(key, {"first", "last", "fixations"});
+    const std::string w = cfg.choice(key, {"first", "last", "fixations", "joints"});
     s.kind = w == "first" ? BeamNodeSelector::Kind::first
              : w == "last" ? BeamNodeSelector::Kind::last
+             : w == "joints" ? BeamNodeSelector::Kind::joints
                            : BeamNodeSelector::Kind::fixations;
     return s;
   }
   ConfigMap m = cfg.map(key);
+  if (m.has("index")) {
+    s.kind = BeamNodeSelector::Kind::index;
+    const YAML::Node n = m.node()["index"];
+    const auto v = m.numbers("index", n.IsSequence() ? n.size() : 1);
+    for (double x : v) {
+      if (x < 0 || x != std::floor(x)) m.fail("index", "expected non-negative node numbers");
+      s.indices.push_back(static_cast<int>(x));
+    }
+    if (s.indices.empty()) m.fail("index", "expected at least one node number");
+    m.finish();
+    return s;
+  }
   s.kind = BeamNodeSelector::Kind::point;
   s.point = vec3(m, "point");
   s.tolerance = m.quantity("tolerance", units::kLength, -1.0);
@@ -191,13 +274,33 @@ std::vector<int> select_beam_nodes(const BeamBodyDesc& d, const BeamNodeSelector
     case BeamNodeSelector::Kind::fixations:
       for (const auto& f : d.fixations) out.push_back(f.node);
       return out;
+    case BeamNodeSelector::Kind::joints: {
+      if (d.joint_map.master.empty()) return out;
+      std::vector<bool> seen(b.nodes.size(), false);
+      for (const auto& j : d.joints) {
+        const int m = d.joint_map.master[static_cast<std::size_t>(j[0])];
+        if (!seen[static_cast<std::size_t>(m)]) seen[static_cast<std::size_t>(m)] = true, out.push_back(m);
+      }
+      std::sort(out.begin(), out.end());
+      return out;
+    }
+    case BeamNodeSelector::Kind::index:
+      for (int i : s.indices) {
+        if (i >= static_cast<int>(b.nodes.size()) || !ends[static_cast<std::size_t>(i)])
+          throw InputError(fmt::format("beam node index {} is not an element end node (0..{})", i, b.nodes.size() - 1));
+        out.push_back(i);
+      }
+      return out;
     case BeamNodeSelector::Kind::point: {
       Eigen::Vector3d lo = b.nodes[0].position, hi = lo;
       for (const auto& n : b.nodes) lo = lo.cwiseMin(n.position), hi = hi.cwiseMax(n.position);
       const double tol = s.tolerance >= 0 ? s.tolerance : 1e-6 * std::max((hi - lo).norm(), 1e-300);
       for (int i = 0; i < static_cast<int>(b.nodes.size()); ++i)
-        if (ends[static_cast<std::size_t>(i)] && (b.nodes[static_cast<std::size_t>(i)].position - s.point).norm() <= tol)
-          out.push_back(i);
+        if (ends[static_cast<std::size_t>(i)] && (b.nodes[static_cast<std::size_t>(i)].position - s.point).norm() <= tol) {
+          // a joint acts through its master node
+          const int m = d.joint_map.master.empty() ? i : d.joint_map.master[static_cast<std::size_t>(i)];
+          if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
+        }
       return out;
     }
   }

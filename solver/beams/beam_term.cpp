@@ -3,6 +3,7 @@
 #include "common/error.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <cmath>
 #include <utility>
 
@@ -127,8 +128,14 @@ void BeamTerm::assemble(const SystemState& state, Assembler& out) {
   const std::size_t ne = body_.elements.size();
   std::array<Eigen::Vector3d, 4> x;
   std::array<Eigen::Quaterniond, 3> q;
+  // MPI: every rank evaluates every element (beam bodies are small) so that
+  // each rank holds the whole trial history, and commit() gives every rank
+  // the whole committed history (rank 0 writes outputs and checkpoints);
+  // only the rank's own elements go to the assembler, which sums over ranks.
+  const bool plastic = body_.section.plastic.has_value();
   for (std::size_t e = 0; e < ne; ++e) {
-    if (!state.owns(e, ne)) continue;
+    const bool mine = state.owns(e, ne);
+    if (!mine && !plastic) continue;
     gather(state.u, e, x, q);
     const std::vector<GlobalDof> d = element_dofs(e);
     // Plastic sections: return from the committed history; the trial history
@@ -138,13 +145,14 @@ void BeamTerm::assemble(const SystemState& state, Assembler& out) {
     if (body_.interpolation == BeamInterpolation::hermite3) {
       ElementSystem<4, 3> s;
       element_system<4, 3>(refs_[e], body_.section, x, q, s, hc, ht, &work_trial_[e]);
-      out.add(d, s.R, s.K);
+      if (mine) out.add(d, s.R, s.K);
     } else {
       ElementSystem<2, 2> s;
       element_system<2, 2>(refs_[e], body_.section, x, q, s, hc, ht, &work_trial_[e]);
-      out.add(d, s.R, s.K);
+      if (mine) out.add(d, s.R, s.K);
     }
   }
+  assembled_serial_ = state_serial_;
 }
 
 void BeamTerm::trial(const Eigen::VectorXd& du) {
@@ -152,11 +160,21 @@ void BeamTerm::trial(const Eigen::VectorXd& du) {
     const Eigen::Vector3d dth = read(du, dofs_[n].rot);
     trial_[n] = (quat_exp(dth) * accepted_[n]).normalized();
   }
+  ++state_serial_;
 }
-void BeamTerm::accept() { accepted_ = trial_; }
+void BeamTerm::accept() {
+  accepted_ = trial_;
+  accepted_serial_ = state_serial_;
+}
 void BeamTerm::commit() {
-  // Assumes the last assemble() was at the converged state (Newton checks the
-  // residual there). MPI: each rank updates the elements it owns.
+  // The trial history is that of the last assemble(); it is the converged
+  // one only if that assemble was at the accepted state (Newton re-assembles
+  // after accepting its last iterate). Anything else would silently keep the
+  // history of another iterate, so it is refused.
+  if (body_.section.plastic && assembled_serial_ != accepted_serial_)
+    throw std::logic_error("beam body '" + name_ +
+                           "': commit() without an assemble() at the accepted state; the plastic history would be "
+                           "that of another iterate");
   committed_ = accepted_;
   if (body_.section.plastic) {
     hist_committed_ = hist_trial_;
@@ -168,11 +186,14 @@ void BeamTerm::rollback() {
   accepted_ = trial_ = committed_;
   hist_trial_ = hist_committed_;
   std::fill(work_trial_.begin(), work_trial_.end(), 0.0);
+  // the trial history is the committed one: consistent with the accepted state
+  accepted_serial_ = assembled_serial_ = ++state_serial_;
 }
 
 void BeamTerm::set_rotation(int node, const Eigen::Quaterniond& q) {
   trial_.at(node) = q.normalized();
   accepted_[node] = trial_[node];
+  accepted_serial_ = ++state_serial_;
 }
 
 Eigen::Vector3d BeamTerm::position(const Eigen::VectorXd& u, int node) const {
@@ -257,6 +278,7 @@ void BeamTerm::load_history(const HistoryArchive& in, const std::string& prefix)
     plastic_work_committed_ = in.get_scalar(prefix + "plastic_work");
     std::fill(work_trial_.begin(), work_trial_.end(), 0.0);
   }
+  accepted_serial_ = assembled_serial_ = ++state_serial_;
 }
 
 }  // namespace stentsim::solver::beams

@@ -67,6 +67,8 @@ class BeamTerm : public Term {
   void assemble(const SystemState& state, Assembler& out) override;
   void trial(const Eigen::VectorXd& du) override;
   void accept() override;
+  /// Plastic sections: throws std::logic_error unless the last assemble()
+  /// was at the accepted state (the converged one), whose trial history it keeps.
   void commit() override;
   void rollback() override;
   /// Restart: the committed nodal triads (quaternions w, x, y, z per node) under
@@ -120,6 +122,11 @@ class BeamTerm : public Term {
   std::vector<PlasticBendingHistory> hist_committed_, hist_trial_;
   std::vector<double> work_trial_;  // plastic work increment of element e in the last assemble
   double plastic_work_committed_ = 0.0;
+  // Which state the trial history belongs to: trial()/set_rotation() start a
+  // new state, accept() marks it accepted, assemble() marks the history as
+  // evaluated at it. commit() of a plastic body requires the accepted state
+  // to be the assembled one (see commit()).
+  long long state_serial_ = 0, accepted_serial_ = 0, assembled_serial_ = 0;
 };
 
 }  // namespace stentsim::solver::beams

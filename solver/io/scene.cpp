@@ -206,20 +206,61 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   };
   // A beam node selection must select something (file:line of the key).
   auto check_nodes = [&](ConfigMap& c, const std::string& body, const beams::BeamNodeSelector& sel) {
-    if (beams::select_beam_nodes(beam_body(body), sel).empty())
-      c.fail("node", fmt::format("selects no end node of beam body '{}' ({})", body, sel.describe()));
+    std::vector<int> nodes;
+    try {
+      nodes = beams::select_beam_nodes(beam_body(body), sel);
+    } catch (const InputError& e) {
+      c.fail("node", e.what());
+    }
+    if (nodes.empty()) c.fail("node", fmt::format("selects no end node of beam body '{}' ({})", body, sel.describe()));
   };
+  // Cylindrical beam conditions: `axis: {origin, direction}` (default the z axis).
+  auto read_axis = [&](ConfigMap& c, ConditionDesc& d) {
+    if (auto ax = c.optional_map("axis")) {
+      d.axis_origin = vec3(*ax, "origin", Vec3::Zero());
+      d.axis = vec3(*ax, "direction", Vec3::UnitZ());
+      if (!(d.axis.norm() > 0)) ax->fail("direction", "must be a non-zero vector");
+      d.axis.normalize();
+      ax->finish();
+    }
+  };
+  std::map<std::string, std::string> radial_conditions;  // radial_displacement name -> body (for release)
+  std::set<std::string> released;
 
   int index = 0;
   for (auto& c : root.map_list("conditions")) {
     ConditionDesc d;
     const std::string type =
-        c.choice("type", {"pressure", "springs", "dirichlet", "clamp", "point_force", "point_moment", "direction"});
+        c.choice("type", {"pressure", "springs", "dirichlet", "clamp", "point_force", "point_moment", "direction",
+                          "radial_displacement", "fix_cylindrical", "release"});
     d.name = c.string("name", fmt::format("{}_{}", type, index++));
+    for (const auto& other : scene.conditions)
+      if (other.name == d.name) c.fail("name", fmt::format("condition name '{}' is used twice", d.name));
     d.body = c.string("body");
     check_body(c, d.body);
-    const bool beam_type = type == "clamp" || type == "point_force" || type == "point_moment" || type == "direction";
+    const bool beam_type = type == "clamp" || type == "point_force" || type == "point_moment" || type == "direction" ||
+                           type == "radial_displacement" || type == "fix_cylindrical" || type == "release";
     check_kind(c, d.body, beam_type, type);
+    if (type == "release") {
+      // The radial conditions become point forces equal to their last reactions, × curve(t) after `at`.
+      d.type = ConditionDesc::Type::release;
+      d.release_from = c.string("from");
+      auto it = radial_conditions.find(d.release_from);
+      if (it == radial_conditions.end())
+        c.fail("from", fmt::format("no radial_displacement condition named '{}' before this one", d.release_from));
+      if (it->second != d.body) c.fail("from", fmt::format("'{}' holds body '{}', not '{}'", d.release_from, it->second, d.body));
+      if (!released.insert(d.release_from).second) c.fail("from", fmt::format("'{}' is released twice", d.release_from));
+      d.release_at = c.quantity("at", units::kTime);
+      d.curve = c.string("curve");
+      check_curve(c, d.curve);
+      const double f = scene.curves.at(d.curve)(d.release_at);
+      if (std::abs(f - 1.0) > 1e-12)
+        c.fail("curve", fmt::format("the release curve '{}' must be 1 at the release time {} (it is {}): the forces start "
+                                    "at the last reactions", d.curve, d.release_at, f));
+      c.finish();
+      scene.conditions.push_back(d);
+      continue;
+    }
     if (beam_type) {
       d.node = beams::read_beam_node_selector(c, "node");
       check_nodes(c, d.body, d.node);
@@ -260,6 +301,28 @@ SceneDesc read_scene(const std::filesystem::path& file) {
           if (!(d.vector.norm() > 0)) c.fail("direction", "must be a non-zero vector");
           d.vector.normalize();
         }
+      } else if (type == "radial_displacement") {
+        d.type = ConditionDesc::Type::radial_displacement;
+        read_axis(c, d);
+        d.value = c.quantity("value", units::kLength);
+        d.curve = c.string("curve", "");
+      } else if (type == "fix_cylindrical") {
+        d.type = ConditionDesc::Type::fix_cylindrical;
+        read_axis(c, d);
+        const std::string text = c.string("components");  // words: radial circumferential axial
+        std::string w;
+        for (std::size_t i = 0; i <= text.size(); ++i) {
+          if (i == text.size() || text[i] == ' ' || text[i] == ',') {
+            if (w.empty()) continue;
+            const int k = w == "radial" ? 0 : w == "circumferential" ? 1 : w == "axial" ? 2 : -1;
+            if (k < 0) c.fail("components", fmt::format("'{}' is not one of radial, circumferential, axial", w));
+            if (std::find(d.components.begin(), d.components.end(), k) == d.components.end()) d.components.push_back(k);
+            w.clear();
+          } else {
+            w += text[i];
+          }
+        }
+        if (d.components.empty()) c.fail("components", "expected some of: radial circumferential axial");
       } else {
         d.type = type == "point_force" ? ConditionDesc::Type::point_force : ConditionDesc::Type::point_moment;
         d.vector = vec3(c, "value");  // N (force) or N mm (moment), dead (fixed in space)
@@ -268,6 +331,7 @@ SceneDesc read_scene(const std::filesystem::path& file) {
       check_curve(c, d.curve);
       c.finish();
       scene.conditions.push_back(d);
+      if (d.type == ConditionDesc::Type::radial_displacement) radial_conditions[d.name] = d.body;
       continue;
     }
     if (type == "pressure") {
@@ -315,6 +379,7 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   scene.stepping.dt_max = time.quantity("dt_max", units::kTime, scene.stepping.dt_initial, Range::positive());
   scene.stepping.dt_min = time.quantity("dt_min", units::kTime, 1e-6 * (scene.stepping.t_end - scene.stepping.t_start), Range::positive());
   scene.stepping.max_cuts = time.integer("max_cuts", 8, Range::between(0, 60));
+  scene.stepping.max_consecutive_cuts = time.integer("max_consecutive_cuts", 12, Range::between(0, 200));
   scene.stepping.grow_factor = time.number("grow_factor", 1.5, Range{1.0, 10.0});
   scene.stepping.cut_factor = time.number("cut_factor", 0.5, Range{0.0, 1.0, false, false});
   scene.stepping.easy_iterations = time.integer("easy_iterations", 5, Range::between(1, 100));
@@ -323,6 +388,14 @@ SceneDesc read_scene(const std::filesystem::path& file) {
     scene.stepping.stops = time.numbers("stops", n.IsSequence() ? n.size() : 0);
   }
   time.finish();
+  // A release happens at the end of a converged step: its time is a stop inside the run.
+  for (const auto& c : scene.conditions) {
+    if (c.type != ConditionDesc::Type::release) continue;
+    if (!(c.release_at > scene.stepping.t_start && c.release_at < scene.stepping.t_end))
+      throw InputError(fmt::format("{}: condition '{}': release time at = {} must lie inside solver.time ({}, {})", file.string(),
+                                   c.name, c.release_at, scene.stepping.t_start, scene.stepping.t_end));
+    scene.stepping.stops.push_back(c.release_at);
+  }
   ConfigMap nw = s.map("newton");
   scene.newton.max_iterations = nw.integer("max_iterations", 20, Range::between(1, 1000));
   scene.newton.residual_tolerance = nw.number("residual_tolerance", 1e-8, Range::positive());
@@ -351,15 +424,36 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   for (auto& q : root.map_list("qoi")) {
     QoiDesc d;
     d.name = q.string("name");
-    const std::string type = q.choice("type", {"mean_radius", "max_displacement", "tip_position", "tip_rotation_angle"});
-    d.type = type == "mean_radius"        ? QoiDesc::Type::mean_radius
-             : type == "max_displacement" ? QoiDesc::Type::max_displacement
-             : type == "tip_position"     ? QoiDesc::Type::tip_position
-                                          : QoiDesc::Type::tip_rotation_angle;
+    const std::string type =
+        q.choice("type", {"mean_radius", "max_displacement", "tip_position", "tip_rotation_angle", "ring_expansion"});
+    d.type = type == "mean_radius"          ? QoiDesc::Type::mean_radius
+             : type == "max_displacement"   ? QoiDesc::Type::max_displacement
+             : type == "tip_position"       ? QoiDesc::Type::tip_position
+             : type == "ring_expansion"     ? QoiDesc::Type::ring_expansion
+                                            : QoiDesc::Type::tip_rotation_angle;
     d.body = q.string("body");
     check_body(q, d.body);
-    const bool beam_qoi = d.type == QoiDesc::Type::tip_position || d.type == QoiDesc::Type::tip_rotation_angle;
+    const bool beam_qoi = d.type == QoiDesc::Type::tip_position || d.type == QoiDesc::Type::tip_rotation_angle ||
+                          d.type == QoiDesc::Type::ring_expansion;
     check_kind(q, d.body, beam_qoi, type);
+    if (d.type == QoiDesc::Type::ring_expansion) {
+      for (const auto& other : scene.qois)
+        if (other.type == QoiDesc::Type::ring_expansion) q.fail("type", "one ring_expansion QoI per scene (its summary keys have no prefix)");
+      d.node = beams::read_beam_node_selector(q, "node");
+      check_nodes(q, d.body, d.node);
+      if (auto ax = q.optional_map("axis")) {
+        d.axis_origin = vec3(*ax, "origin", Vec3::Zero());
+        d.axis = vec3(*ax, "direction", Vec3::UnitZ()).normalized();
+        ax->finish();
+      }
+      d.time = q.quantity("peak_time", units::kTime);  // D_max; D_end at the end
+      if (!(d.time > scene.stepping.t_start && d.time <= scene.stepping.t_end))
+        q.fail("peak_time", "must lie inside solver.time");
+      scene.stepping.stops.push_back(d.time);
+      q.finish();
+      scene.qois.push_back(d);
+      continue;
+    }
     if (beam_qoi) {
       d.node = beams::read_beam_node_selector(q, "node");
       if (d.node.kind == beams::BeamNodeSelector::Kind::fixations) q.fail("node", "a tip QoI needs one node (first, last or a point)");

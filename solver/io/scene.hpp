@@ -41,8 +41,15 @@ struct BodyDesc {
 
 struct ConditionDesc {
   // pressure, springs, dirichlet: solid bodies. clamp, point_force,
-  // point_moment, direction: beam bodies (node by beams::BeamNodeSelector).
-  enum class Type { pressure, springs, dirichlet, clamp, point_force, point_moment, direction } type = Type::pressure;
+  // point_moment, direction, radial_displacement, fix_cylindrical, release:
+  // beam bodies (node by beams::BeamNodeSelector).
+  //   radial_displacement: (r − X)·e_r = value·curve(t) about `axis` (beams/radial_release.hpp)
+  //   fix_cylindrical: zero displacement components (0 radial, 1 circumferential,
+  //     2 axial) in the node's reference cylindrical frame about `axis`
+  //   release: from time `release_at` on, the radial_displacement condition
+  //     `release_from` becomes point forces equal to its last reactions × curve(t)
+  enum class Type { pressure, springs, dirichlet, clamp, point_force, point_moment, direction, radial_displacement,
+                    fix_cylindrical, release } type = Type::pressure;
   std::string name, body, curve;            // curve "" = constant 1
   Selector where;
   double value = 0.0;                       // pressure (MPa), stiffness (N/mm^3) or displacement (mm)
@@ -54,12 +61,18 @@ struct ConditionDesc {
   bool clamp_position = true, clamp_rotation = true, clamp_tangent = false;
   Vec3 vector = Vec3::Zero();               // point_force (N), point_moment (N mm), direction
   bool direction_from_file = false;         // direction: the stent file's fixation directions
+  std::string release_from;                 // release: the radial_displacement condition
+  double release_at = 0.0;                  // release: time (a stop)
 };
 
 struct QoiDesc {
   std::string name;
-  // tip_position (vector, mm) and tip_rotation_angle (rad, accumulated over steps): beam bodies
-  enum class Type { mean_radius, max_displacement, tip_position, tip_rotation_angle } type = Type::mean_radius;
+  // tip_position (vector, mm) and tip_rotation_angle (rad, accumulated over steps): beam bodies.
+  // ring_expansion (beam bodies): mean diameter 2·mean(‖(r − o)⊥axis‖) of the
+  // selected nodes at `time` (D_max) and at the end (D_end), recoil_percent =
+  // 100 (D_max − D_end)/D_max, and the largest ‖M_b‖ over all Gauss points at
+  // both times (max_bending_moment_peak, _end); summary keys without prefix.
+  enum class Type { mean_radius, max_displacement, tip_position, tip_rotation_angle, ring_expansion } type = Type::mean_radius;
   std::string body;
   Selector where;
   beams::BeamNodeSelector node;
