@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cmath>
+#include <limits>
 #include <numbers>
 
 using namespace stentsim::solver;
@@ -22,8 +24,11 @@ namespace {
 constexpr double R = 100.0, E = 1e7, G = 5e6;
 const double L = R * std::numbers::pi / 4;
 const double loads[3] = {300.0, 450.0, 600.0};
-// Simo & Vu-Quoc 1986 (8 linear elements), for the note only.
-const double literature[3][3] = {{22.5, 59.2, 39.5}, {15.9, 47.2, 53.4}, {12.7, 41.1, 58.1}};
+// Literature tips for the note only (not pass criteria): Simo & Vu-Quoc 1986, Example 7.5 (8 linear
+// elements) at F = 300 and 600; they compare with Bathe & Bolourchi 1979: (22.5, 59.2, 39.5) at 300 and
+// (15.9, 47.2, 53.4) at 600. No value at F = 450 is taken from a source we hold (NaN: not printed).
+const double nan = std::numeric_limits<double>::quiet_NaN();
+const double literature[3][3] = {{22.33, 58.84, 40.08}, {nan, nan, nan}, {15.79, 47.23, 53.37}};
 
 BeamSection square() { return BeamSection::from_values(E, G, 1.0, 1.0, 1.0, 1.0 / 12, 1.0 / 12, 1.0 / 6); }
 
@@ -106,9 +111,11 @@ TEST(BeamBend45, HermiteTipMatchesShootingAndConverges) {
     }
   }
   for (int k = 0; k < 3; ++k) {
-    std::printf("F=%3.0f: shooting (%.4f, %.4f, %.4f); 16 elements (%.4f, %.4f, %.4f); Simo & Vu-Quoc (%.1f, %.1f, %.1f)\n",
-                loads[k], ref[k].x(), ref[k].y(), ref[k].z(), tips16[k].x(), tips16[k].y(), tips16[k].z(),
-                literature[k][0], literature[k][1], literature[k][2]);
+    std::printf("F=%3.0f: shooting (%.4f, %.4f, %.4f); 16 elements (%.4f, %.4f, %.4f)", loads[k], ref[k].x(),
+                ref[k].y(), ref[k].z(), tips16[k].x(), tips16[k].y(), tips16[k].z());
+    if (!std::isnan(literature[k][0]))
+      std::printf("; Simo & Vu-Quoc (%.2f, %.2f, %.2f)", literature[k][0], literature[k][1], literature[k][2]);
+    std::printf("\n");
     EXPECT_LT(err[2][k], 0.05) << "16 elements, F=" << loads[k];
   }
 }

@@ -83,9 +83,9 @@ TEST(BeamRollup, LagrangeClosesExactlyForEqualElements) {
   }
 }
 
-// Not a pass criterion: how the roll-up error depends on the Hermite quadrature.
-TEST(BeamRollup, HermiteQuadratureStudy) {
-  if (!std::getenv("STENTSIM_BEAM_STUDY")) GTEST_SKIP() << "set STENTSIM_BEAM_STUDY=1";
+// Not a pass criterion, so disabled: how the roll-up error depends on the Hermite quadrature.
+// Run it with --gtest_also_run_disabled_tests --gtest_filter='*HermiteQuadratureStudy'.
+TEST(BeamRollup, DISABLED_HermiteQuadratureStudy) {
   for (int gp : {3, 4, 5}) {
     std::printf("gauss points %d:", gp);
     for (int n : {4, 8, 16, 32}) std::printf("  e_%d/L=%.3e", n, rollup(n, BeamInterpolation::hermite3, gp).tip_error / L);
