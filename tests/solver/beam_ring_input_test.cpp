@@ -1,0 +1,153 @@
+// Beam scenes with plasticity, rigid joints and the release condition
+// (issue 9): what the scene reader and the condition resolution accept and
+// refuse. Fast: no load steps are solved.
+// - `material: stent` gives the App. C preset with elasto-plastic bending;
+// - stent files are coupled by rigid joints: DOFs of the 210-element stent
+//   3,150 nodal → 2,694 after coupling (`joints: none` keeps 3,150); the ring
+//   720 → 624;
+// - `node: joints` selects the 16 crown masters; a point on a joint selects
+//   its master; a condition on a slave node ({index}) is an InputError naming
+//   the node and its master;
+// - release: unknown source, a curve that is not 1 at the release time and a
+//   release time outside the run are InputErrors naming the condition.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "common/mesh_data.hpp"
+#include "device_gen/stent_design.hpp"
+#include "device_gen/stent_mesh.hpp"
+#include "device_gen/stent_model.hpp"
+#include "solver/app/solve.hpp"
+#include "solver/io/scene.hpp"
+
+namespace stentsim::solver {
+namespace {
+
+const std::filesystem::path kExamples = std::filesystem::path(STENTSIM_TEST_SOURCE_DIR) / "examples";
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("stentsim_ring_input_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  if (at == std::string::npos) throw std::runtime_error("example has no '" + from + "'");
+  return text.replace(at, from.size(), to);
+}
+
+std::string example() {
+  return replaced(files::read_text(kExamples / "stent_ring_expansion.yaml"), "file: data/stent_ring_3el.vtu",
+                  "file: " + (kExamples / "data/stent_ring_3el.vtu").string());
+}
+
+// The error of reading (and, with `solve`, of resolving the conditions of) a scene text.
+std::string error_of(const std::string& text, bool solve = false) {
+  const auto dir = fresh_dir("err");
+  files::write_atomic(dir / "scene.yaml", text);
+  try {
+    if (solve) {
+      SolveOptions o;
+      o.output_dir = dir / "out";
+      solve_scene(dir / "scene.yaml", o);
+    } else {
+      read_scene(dir / "scene.yaml");
+    }
+  } catch (const InputError& e) {
+    std::filesystem::remove_all(dir);
+    return e.what();
+  }
+  std::filesystem::remove_all(dir);
+  return "";
+}
+
+}  // namespace
+
+TEST(BeamRingInput, StentPresetJointsAndCrownSelection) {
+  const auto dir = fresh_dir("ok");
+  files::write_atomic(dir / "scene.yaml", example());
+  const SceneDesc s = read_scene(dir / "scene.yaml");
+  ASSERT_EQ(s.bodies.size(), 1u);
+  const beams::BeamBodyDesc& b = *s.bodies[0].beam;
+  ASSERT_TRUE(b.body.section.plastic.has_value());
+  EXPECT_EQ(b.body.section.plastic->E, 380000.0);
+  EXPECT_EQ(b.body.section.plastic->G, 190000.0);
+  EXPECT_EQ(b.body.section.plastic->E_ep, 64000.0);
+  EXPECT_EQ(b.body.section.plastic->M_y0, 0.08);
+  EXPECT_DOUBLE_EQ(b.body.section.plastic->radius, 0.06);
+  EXPECT_EQ(b.body.elements.size(), 48u);
+  GlobalDof n = 0;
+  b.number_dofs(0, &n);
+  EXPECT_EQ(beams::beam_nodal_dof_count(b.body), 720);
+  EXPECT_EQ(n, 624);  // 16 slave nodes lose their 6 position and rotation DOFs
+  beams::BeamNodeSelector joints;
+  joints.kind = beams::BeamNodeSelector::Kind::joints;
+  const auto crowns = beams::select_beam_nodes(b, joints);
+  EXPECT_EQ(crowns.size(), 16u);
+  for (int c : crowns) EXPECT_FALSE(b.joint_map.is_slave(c));
+  beams::BeamNodeSelector at;
+  at.kind = beams::BeamNodeSelector::Kind::point;
+  at.point = Vec3(0.575, 0, -0.75);
+  EXPECT_EQ(beams::select_beam_nodes(b, at), std::vector<int>{0});  // nodes 0 and 111 meet there; 0 is the master
+  // the release is a stop of the stepping
+  EXPECT_NE(std::find(s.stepping.stops.begin(), s.stepping.stops.end(), 20.0), s.stepping.stops.end());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BeamRingInput, StentDofCountsWithAndWithoutJoints) {
+  device_gen::StentDesign d;  // 4 rings, 3 elements per strut: 210 elements
+  const auto model = device_gen::build_stent(d, device_gen::DeviceAxis::straight(d.length()));
+  const auto dir = fresh_dir("stent");
+  write_vtu((dir / "stent.vtu").string(), device_gen::stent_to_mesh(model, d));
+  for (const std::string joints : {"rigid", "none"}) {
+    const std::string text = fmt::format(R"(bodies:
+  - name: stent
+    beam: {{file: stent.vtu, material: stent, joints: {}}}
+conditions:
+  - {{name: hold, type: clamp, body: stent, node: fixations}}
+solver: {{time: {{end: 1}}}}
+output: {{every: 1}}
+)", joints);
+    files::write_atomic(dir / "scene.yaml", text);
+    const SceneDesc s = read_scene(dir / "scene.yaml");
+    const beams::BeamBodyDesc& b = *s.bodies[0].beam;
+    GlobalDof n = 0;
+    b.number_dofs(0, &n);
+    EXPECT_EQ(b.body.elements.size(), 210u);
+    EXPECT_EQ(beams::beam_nodal_dof_count(b.body), 3150);
+    EXPECT_EQ(n, joints == "rigid" ? 2694 : 3150) << joints;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BeamRingInput, ConditionOnASlaveNodeNamesIt) {
+  const std::string text = replaced(example(), "  - name: release_crowns",
+                                    "  - {name: bad_clamp, type: clamp, body: ring, node: {index: [111]}}\n"
+                                    "  - name: release_crowns");
+  const std::string e = error_of(text, true);
+  EXPECT_NE(e.find("bad_clamp"), std::string::npos) << e;
+  EXPECT_NE(e.find("node 111 is the slave of a rigid joint"), std::string::npos) << e;
+  EXPECT_NE(e.find("master node 0"), std::string::npos) << e;
+}
+
+TEST(BeamRingInput, ReleaseIsValidated) {
+  std::string e = error_of(replaced(example(), "from: crowns_radial", "from: nothing"));
+  EXPECT_NE(e.find("no radial_displacement condition named 'nothing'"), std::string::npos) << e;
+  e = error_of(replaced(example(), "unload: [[20, 1], [30, 0]]", "unload: [[20, 0.5], [30, 0]]"));
+  EXPECT_NE(e.find("must be 1 at the release time"), std::string::npos) << e;
+  e = error_of(replaced(example(), "    at: 20\n", "    at: 0\n"));
+  EXPECT_NE(e.find("release_crowns"), std::string::npos) << e;
+  EXPECT_NE(e.find("must lie inside solver.time"), std::string::npos) << e;
+  e = error_of(replaced(example(), "material: stent", "material: stent\n      E: 1000 MPa"));
+  EXPECT_NE(e.find("the stent preset sets E, G"), std::string::npos) << e;
+}
+
+}  // namespace stentsim::solver
