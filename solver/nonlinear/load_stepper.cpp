@@ -19,6 +19,7 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
   const double eps = 1e-12 * std::max(1.0, std::abs(s.t_end));
   double t = s.t_start, dt = std::min(s.dt_initial, s.dt_max);
   int step = s.first_step;
+  int cuts_since_easy = 0;  // the stall counter: cuts since the last easy step
   const auto run_start = std::chrono::steady_clock::now();
   while (t < s.t_end - eps) {
     const double next_stop = *std::upper_bound(stops.begin(), stops.end(), t + eps);
@@ -38,17 +39,30 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
         t += h;
         rec.dt = h;
         rec.residual_norms = nr.residual_norms;
-        if (nr.iterations <= s.easy_iterations && cuts == 0) dt = std::min(dt * s.grow_factor, s.dt_max);
+        if (nr.iterations <= s.easy_iterations && cuts == 0) {
+          dt = std::min(dt * s.grow_factor, s.dt_max);
+          cuts_since_easy = 0;
+        }
         break;
       }
       model.rollback();
       ++cuts;
+      ++cuts_since_easy;
       dt = h * s.cut_factor;
+      std::string why;
+      if (dt < s.dt_min) why = fmt::format("the next step {:.3g} would be below dt_min = {:.3g}", dt, s.dt_min);
+      else if (cuts > s.max_cuts) why = fmt::format("{} cuts in one step (max_cuts = {})", cuts, s.max_cuts);
+      else if (cuts_since_easy > s.max_consecutive_cuts)
+        why = fmt::format("{} cuts since the last easy step (max_consecutive_cuts = {})", cuts_since_easy,
+                          s.max_consecutive_cuts);
+      if (!why.empty()) {
+        const std::string load = s.describe_load ? s.describe_load(t) : fmt::format("t = {:.6g}", t);
+        throw LoadStepStall(fmt::format("no converged state beyond {}: the step of size {:.3g} to t = {:.6g} failed "
+                                        "and {}; last reason: {}",
+                                        load, h, t + h, why, nr.failure),
+                            t, h);
+      }
       log::warn("step at t = {:.6g} (dt = {:.3g}) failed: {}; cutting to dt = {:.3g}", t + h, h, nr.failure, dt);
-      if (cuts > s.max_cuts || dt < s.dt_min)
-        throw ComputeError(fmt::format("load stepping stopped at t = {:.6g}: the step of size {:.3g} failed after {} cuts "
-                                       "(dt_min = {:.3g}, max_cuts = {}); last reason: {}",
-                                       t, h, cuts, s.dt_min, s.max_cuts, nr.failure));
     }
     rec.step = ++step;
     rec.time = t;

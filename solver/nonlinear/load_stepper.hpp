@@ -2,15 +2,25 @@
 // Adaptive load stepping in pseudo-time: a step that fails (no convergence,
 // too many iterations, an element that cannot be evaluated) is rolled back
 // and cut; easy steps let the step grow. Steps end exactly on `stops` (phase
-// ends, output times). On final failure it throws ComputeError naming the
-// time, the step size and the last reason, after the caller's state holds the
-// last converged solution.
+// ends, output times).
+//
+// Stall rule (DESIGN.md §7, issue 11 "Stability"): the stepper gives up when
+//  - a cut would go below dt_min, or
+//  - one step needed more than max_cuts cuts, or
+//  - more than max_consecutive_cuts cuts happened since the last easy step
+//    (one that converged at its first try within easy_iterations and let the
+//    step grow). This catches the creep towards a limit load, where every step
+//    converges only after a cut and dt shrinks geometrically without end
+//    (the tube above its asymptotic pressure crept at dt 1.4e-6 for ever).
+// It then throws LoadStepStall (a ComputeError) with the last converged time;
+// u holds the last converged solution.
 #include <Eigen/Core>
 
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "common/error.hpp"
 #include "solver/nonlinear/newton.hpp"
 
 namespace stentsim::solver {
@@ -18,11 +28,23 @@ namespace stentsim::solver {
 struct StepperSettings {
   double t_start = 0.0, t_end = 1.0;
   double dt_initial = 0.1, dt_min = 1e-5, dt_max = 0.1;
-  int max_cuts = 8;            // consecutive cuts before giving up
+  int max_cuts = 8;            // cuts within one step before giving up
+  int max_consecutive_cuts = 12;  // cuts since the last easy (growing) step before giving up
   double cut_factor = 0.5, grow_factor = 1.5;
   int easy_iterations = 5;     // grow after a step with at most this many Newton iterations
   std::vector<double> stops;   // times a step must end on
   int first_step = 0;          // steps done before t_start (restart: numbering continues)
+  /// Describes the load at pseudo-time t for the stall message, e.g.
+  /// "p = 0.193 MPa (load factor 0.667)"; default "t = ...".
+  std::function<std::string(double)> describe_load;
+};
+
+/// The stepper found no converged state beyond `time` (see the stall rule above).
+class LoadStepStall : public ComputeError {
+ public:
+  LoadStepStall(const std::string& what, double time, double dt) : ComputeError(what), time(time), dt(dt) {}
+  double time;  // last converged pseudo-time
+  double dt;    // the step size that failed last
 };
 
 struct StepRecord {
