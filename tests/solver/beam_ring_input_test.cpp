@@ -3,8 +3,8 @@
 // refuse. Fast: no load steps are solved.
 // - `material: stent` gives the App. C preset with elasto-plastic bending;
 // - stent files are coupled by rigid joints: DOFs of the 210-element stent
-//   3,150 nodal → 2,694 after coupling (`joints: none` keeps 3,150); the ring
-//   720 → 624;
+//   3,150 nodal → 2,694 after coupling (`joints: none` keeps 3,150), the
+//   588-element one 8,820 → 7,524; the ring 720 → 624;
 // - `node: joints` selects the 16 crown masters; a point on a joint selects
 //   its master; a condition on a slave node ({index}) is an InputError naming
 //   the node and its master;
@@ -103,10 +103,15 @@ TEST(BeamRingInput, StentPresetJointsAndCrownSelection) {
 }
 
 TEST(BeamRingInput, StentDofCountsWithAndWithoutJoints) {
-  device_gen::StentDesign d;  // 4 rings, 3 elements per strut: 210 elements
+  // 4 rings: 210 elements, 3,150 → 2,694 DOFs; 11 rings: 588 elements, 8,820 → 7,524
+  for (const int rings : {4, 11}) {
+  device_gen::StentDesign d;
+  d.rings = rings;
   const auto model = device_gen::build_stent(d, device_gen::DeviceAxis::straight(d.length()));
   const auto dir = fresh_dir("stent");
   write_vtu((dir / "stent.vtu").string(), device_gen::stent_to_mesh(model, d));
+  const std::size_t elements = rings == 4 ? 210 : 588;
+  const GlobalDof nodal = rings == 4 ? 3150 : 8820, coupled = rings == 4 ? 2694 : 7524;
   for (const std::string joints : {"rigid", "none"}) {
     const std::string text = fmt::format(R"(bodies:
   - name: stent
@@ -121,11 +126,12 @@ output: {{every: 1}}
     const beams::BeamBodyDesc& b = *s.bodies[0].beam;
     GlobalDof n = 0;
     b.number_dofs(0, &n);
-    EXPECT_EQ(b.body.elements.size(), 210u);
-    EXPECT_EQ(beams::beam_nodal_dof_count(b.body), 3150);
-    EXPECT_EQ(n, joints == "rigid" ? 2694 : 3150) << joints;
+    EXPECT_EQ(b.body.elements.size(), elements);
+    EXPECT_EQ(beams::beam_nodal_dof_count(b.body), nodal);
+    EXPECT_EQ(n, joints == "rigid" ? coupled : nodal) << joints << ", " << rings << " rings";
   }
   std::filesystem::remove_all(dir);
+  }
 }
 
 TEST(BeamRingInput, ConditionOnASlaveNodeNamesIt) {
