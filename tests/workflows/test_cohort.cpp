@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "tests/workflows/cli_runner.hpp"
 #include "workflows/cohort/cohort_plots.hpp"
 #include "workflows/cohort/cohort_runner.hpp"
+#include "workflows/cohort/cohort_slurm.hpp"
 
 namespace fs = std::filesystem;
 using stentsim::files::read_text;
@@ -170,6 +172,33 @@ TEST(CohortSlots, NeverOversubscribeCores) {
   EXPECT_EQ(concurrent_cases(4, 2, 2), 1);
   EXPECT_EQ(concurrent_cases(1, 1, 8), 1);
   EXPECT_EQ(concurrent_cases(8, 4, 2), 1);  // at least one
+}
+
+// The Slurm job array's script and sbatch options, from the cohort file (the
+// cluster runs are in test_cohort_slurm.cpp).
+TEST(CohortSlurmScript, ArrayOptionsAndMpiLauncherFromTheCohortFile) {
+  const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-script-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  ASSERT_EQ(sh("init " + dir.string() + " --cohort").code, 0);
+  const fs::path f = dir / "mpi.yaml";
+  write_atomic(f, "name: mpi\ntemplate: patient.yaml\nranks_per_case: 2\nbackend: slurm\n"
+                  "slurm: {partition: short, time_limit: \"0:30:00\", memory: 4G, extra_sbatch_options: \"--qos=low\"}\n"
+                  "cases:\n  - id: a\n  - id: b\n  - id: c\n");
+  const auto c = stentsim::workflows::load_cohort(f);
+  const auto args = stentsim::workflows::sbatch_array_arguments(c, 3, dir / "logs");
+  for (const std::string want : {"--array=0-2", "--ntasks=2", "--partition=short", "--time=0:30:00", "--mem=4G", "--qos=low"})
+    EXPECT_NE(std::find(args.begin(), args.end(), want), args.end()) << want;
+  EXPECT_NE(std::find(args.begin(), args.end(), "--output=" + (dir / "logs/slurm-%A_%a.out").string()), args.end());
+  const std::string s = stentsim::workflows::slurm_array_script(c, {"a", "c"}, "/opt/st sim", {"--until", "centerline"});
+  EXPECT_NE(s.find("cases=( 'a' 'c' )"), std::string::npos) << s;
+  EXPECT_NE(s.find("'/opt/st sim' run case.yaml '--until' 'centerline' > run.log"), std::string::npos) << s;
+  EXPECT_NE(s.find("mpirun --allow-run-as-root --oversubscribe -np ${SLURM_NTASKS:-2}"), std::string::npos) << s;
+  EXPECT_NE(s.find("mv -f .exit_code.tmp exit_code"), std::string::npos) << s;
+  // One rank per case: no MPI launcher.
+  write_atomic(f, "name: one\ntemplate: patient.yaml\nbackend: slurm\ncases:\n  - id: a\n");
+  EXPECT_EQ(stentsim::workflows::slurm_array_script(stentsim::workflows::load_cohort(f), {"a"}, "/x", {}).find("mpirun"),
+            std::string::npos);
+  fs::remove_all(dir);
 }
 
 }  // namespace

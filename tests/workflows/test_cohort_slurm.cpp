@@ -1,13 +1,12 @@
-// The Slurm back-end of `stentsim cohort run`, for real: each test starts a
-// private single-node Slurm (munged + slurmctld + slurmd, fresh state folder,
-// free ports; test_cohort_slurm_cluster.sh) and always stops it.
-// Skipped only when the Slurm binaries are absent and CI is unset.
+// The Slurm back-end of `stentsim cohort run`, for real, on the private
+// single-node Slurm that the CTest fixture `slurm_cluster` starts before these
+// tests and stops after them (test_cohort_slurm_cluster.sh; SLURM_CONF points
+// at it). Skipped only when Slurm is not installed and CI is unset.
 #include <gtest/gtest.h>
-#include <netinet/in.h>
 #include <signal.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <chrono>
@@ -33,21 +32,19 @@ Result sh(const std::string& args) { return stentsim::testing::run_stentsim(args
 
 bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
 
-int free_port() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  ::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len);
-  const int port = ntohs(a.sin_port);
-  ::close(s);
-  return port;
+std::string capture(const std::string& cmd) {
+  std::string out;
+  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
+  char buf[512];
+  while (p && std::fgets(buf, sizeof buf, p)) out += buf;
+  if (p) ::pclose(p);
+  return out;
 }
 
-const std::string kCluster = std::string(STENTSIM_TEST_SOURCE_DIR) + "/tests/workflows/test_cohort_slurm_cluster.sh";
+// Tasks still pending, running or completing (one line each).
+std::string active_queue() { return capture("squeue -h -r -t PENDING,RUNNING,COMPLETING,CONFIGURING -o %i"); }
+
+int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 // CSV -> case id -> column -> value, for the columns that do not depend on timing.
 std::map<std::string, std::map<std::string, std::string>> results(const fs::path& csv) {
@@ -78,38 +75,52 @@ std::map<std::string, std::map<std::string, std::string>> results(const fs::path
   return out;
 }
 
+// case id -> Slurm task id, from the cohort manifest.
+std::map<std::string, std::string> tasks_of(const fs::path& work) {
+  std::map<std::string, std::string> t;
+  const YAML::Node m = YAML::LoadFile((work / "cohort_manifest.yaml").string());
+  for (const auto& kv : m["slurm_tasks"]) t[kv.first.as<std::string>()] = kv.second["job"].as<std::string>();
+  return t;
+}
+
+// The status line of one case in `cohort status` output, runs of spaces squeezed to one.
+std::string status_line(const std::string& out, const std::string& id) {
+  std::istringstream in(out);
+  for (std::string l; std::getline(in, l);)
+    if (l.rfind(id + " ", 0) == 0) {
+      std::string q;
+      for (char ch : l)
+        if (ch != ' ' || q.empty() || q.back() != ' ') q += ch;
+      return q;
+    }
+  return "";
+}
+
 class CohortSlurm : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!have("sbatch") || !have("slurmctld") || !have("slurmd") || !have("munged")) {
-      if (std::getenv("CI")) FAIL() << "CI is set but the Slurm binaries are missing: run scripts/install-deps.sh";
+    const char* conf = std::getenv("SLURM_CONF");
+    if (!conf || !fs::exists(conf)) {
+      const bool installed = have("sbatch") && have("slurmctld") && have("slurmd") && have("munged");
+      if (installed || std::getenv("CI"))
+        FAIL() << (installed ? "Slurm is installed but the fixture cluster is not running (run the tests through ctest: "
+                               "fixture cohort_slurm_cluster_start)"
+                             : "CI is set but Slurm is missing: run scripts/install-deps.sh");
       GTEST_SKIP() << "Slurm not installed (sbatch, slurmctld, slurmd, munged from slurmctld slurmd slurm-client munge; "
                       "scripts/install-deps.sh installs them)";
     }
-    const std::string tag = std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    cluster = fs::temp_directory_path() / ("stentsim-slurm-" + tag);
-    dir = fs::temp_directory_path() / ("stentsim-cohort-slurm-" + tag);
+    cluster = fs::path(conf).parent_path();
+    dir = cluster.parent_path() / "slurm-cohort-tests" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::remove_all(dir);
     fs::create_directories(dir);
-    const std::string cmd = kCluster + " start " + cluster.string() + " " + std::to_string(free_port()) + " " +
-                            std::to_string(free_port()) + " " + std::to_string(::getpid());
-    started = std::system(cmd.c_str()) == 0;
-    ASSERT_TRUE(started) << "could not start the private Slurm cluster (" << cmd << ")";
-    ::setenv("SLURM_CONF", (cluster / "slurm.conf").c_str(), 1);
     ASSERT_EQ(sh("init " + dir.string() + " --cohort").code, 0);
   }
   void TearDown() override {
-    if (!cluster.empty()) std::system((kCluster + " stop " + cluster.string()).c_str());
-    ::unsetenv("SLURM_CONF");
-    if (!dir.empty()) fs::remove_all(dir);
-  }
-  std::string queue() {
-    std::string out;
-    FILE* p = ::popen("squeue -h -o %A 2>&1", "r");
-    char buf[256];
-    while (p && std::fgets(buf, sizeof buf, p)) out += buf;
-    if (p) ::pclose(p);
-    return out;
+    // Leave the shared cluster idle for the next test.
+    if (cluster.empty()) return;
+    std::system("ids=$(squeue -h -o %A); [ -n \"$ids\" ] && scancel $ids");
+    for (int i = 0; i < 100 && !active_queue().empty(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    fs::remove_all(dir);
   }
   // Three phantom cases from the example cohort, with a given backend block.
   std::string cohort(const std::string& name, const std::string& backend) {
@@ -122,17 +133,18 @@ class CohortSlurm : public ::testing::Test {
     return f.string();
   }
   fs::path cluster, dir;
-  bool started = false;
 };
 
-TEST_F(CohortSlurm, SameResultsAsLocalBackend) {
+TEST_F(CohortSlurm, JobArrayGivesTheLocalResults) {
   const auto local = cohort("local", "");
   auto r = sh("cohort run " + local + " --until centerline");
   ASSERT_EQ(r.code, 0) << r.out;
-  const auto slurm = cohort("slurm", "backend: slurm\nslurm: {partition: debug, time_limit: \"10\", poll_interval_s: 0.2}\n");
+  const auto slurm = cohort("slurm", "backend: slurm\nslurm: {partition: debug, time_limit: \"10\", memory: 500M, poll_interval_s: 0.2}\n");
   r = sh("cohort run " + slurm + " --until centerline");
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("3 cases submitted to Slurm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("probe job"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("submitted job array"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(3 task(s) of 1 rank(s)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << r.out;
   const auto a = results(dir / "local.work/cohort_summary.csv");
   const auto b = results(dir / "slurm.work/cohort_summary.csv");
@@ -140,10 +152,15 @@ TEST_F(CohortSlurm, SameResultsAsLocalBackend) {
   EXPECT_EQ(a, b);  // same statuses and same QoIs, case by case
   EXPECT_EQ(b.at("rca-seed1").at("status"), "done");
   EXPECT_FALSE(b.at("rca-seed1").at("centerline.min_radius [mm]").empty());
-  // Each case ran as a Slurm job: its script, its Slurm output file, its exit code.
-  EXPECT_TRUE(fs::exists(dir / "slurm.work/straight/slurm_job.sh"));
-  EXPECT_EQ(read_text(dir / "slurm.work/straight/exit_code"), "0\n");
-  EXPECT_NE(read_text(dir / "slurm.work/slurm_jobs.txt").find("severe "), std::string::npos);
+  // One array: tasks <job>_0.._2 in cohort order, each with its exit-code file and Slurm output.
+  const auto t = tasks_of(dir / "slurm.work");
+  ASSERT_EQ(t.size(), 3u);
+  const std::string job = t.at("rca-seed1").substr(0, t.at("rca-seed1").find('_'));
+  EXPECT_EQ(t.at("rca-seed1"), job + "_0");
+  EXPECT_EQ(t.at("straight"), job + "_1");
+  EXPECT_EQ(t.at("severe"), job + "_2");
+  EXPECT_EQ(read_text(dir / "slurm.work/straight/exit_code"), "0 " + job + "_1\n");
+  EXPECT_NE(read_text(dir / ("slurm.work/slurm/slurm-" + job + "_1.out")).find("case straight: exit 0"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "slurm.work/plot_centerline.min_radius.png"));
 
   // A submission the cluster rejects is a clear error and leaves no jobs behind.
@@ -151,12 +168,83 @@ TEST_F(CohortSlurm, SameResultsAsLocalBackend) {
   r = sh("cohort run " + bad + " --until centerline");
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("sbatch failed"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("case 'rca-seed1'"), std::string::npos) << r.out;
-  EXPECT_EQ(queue(), "");
+  EXPECT_NE(r.out.find("nope"), std::string::npos) << r.out;
+  EXPECT_EQ(active_queue(), "");
 }
 
-TEST_F(CohortSlurm, InterruptCancelsSubmittedJobs) {
-  // Hold every job in the queue (--hold), so the interrupt finds them pending.
+// --no-wait, `cohort status`, a lost task, and re-runs that attach to queued
+// tasks and resubmit only the lost case. Tasks are held (--hold) so that they
+// are certainly pending while the test looks at them.
+TEST_F(CohortSlurm, NoWaitStatusLostTaskAndReattach) {
+  const auto f = cohort("held", "backend: slurm\nslurm: {extra_sbatch_options: \"--hold\", poll_interval_s: 0.2}\n");
+  const fs::path work = dir / "held.work";
+  auto r = sh("cohort run " + f + " --until centerline --no-wait");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("3 to submit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not waiting (--no-wait)"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(work / "cohort_summary.csv"));  // nothing finished yet
+  const auto t1 = tasks_of(work);
+  ASSERT_EQ(t1.size(), 3u);
+  EXPECT_EQ(lines(active_queue()), 3) << active_queue();
+
+  // The straight case's task leaves the queue without running: lost.
+  capture("scancel " + t1.at("straight"));
+  for (int i = 0; i < 50 && lines(active_queue()) > 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  r = sh("cohort status " + f);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(status_line(r.out, "rca-seed1").find(t1.at("rca-seed1") + " pending"), std::string::npos) << r.out;
+  EXPECT_NE(status_line(r.out, "straight").find(t1.at("straight") + " failed (lost: time, memory or node)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("lost: time, memory or node (Slurm task " + t1.at("straight")), std::string::npos) << r.out;
+
+  // Re-run: attaches to the two pending tasks, resubmits only the lost case.
+  r = sh("cohort run " + f + " --until centerline --no-wait");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("1 to submit, 2 queued or running (attached), 0 up to date"), std::string::npos) << r.out;
+  const auto t2 = tasks_of(work);
+  EXPECT_EQ(t2.at("rca-seed1"), t1.at("rca-seed1"));
+  EXPECT_EQ(t2.at("severe"), t1.at("severe"));
+  EXPECT_NE(t2.at("straight"), t1.at("straight"));
+  EXPECT_EQ(lines(active_queue()), 3) << active_queue();
+
+  // Release everything; a waiting run attaches to all three and submits nothing.
+  for (const auto& job : {t1.at("rca-seed1"), t2.at("straight")}) capture("scontrol release " + job.substr(0, job.find('_')));
+  r = sh("cohort run " + f + " --until centerline");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("submitted job array"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << r.out;
+  EXPECT_EQ(results(work / "cohort_summary.csv").at("straight").at("status"), "done");
+  r = sh("cohort status " + f);
+  EXPECT_NE(status_line(r.out, "straight").find(t2.at("straight") + " done"), std::string::npos) << r.out;
+
+  // Everything up to date: no probe, no submission.
+  r = sh("cohort run " + f + " --until centerline");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("0 to submit, 0 queued or running (attached), 3 up to date"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("probe job"), std::string::npos) << r.out;
+}
+
+// A work folder the compute node does not see (the fixture's slurmd runs with
+// an empty tmpfs over <cluster>/hidden): the probe job stops the run before
+// any case is submitted.
+TEST_F(CohortSlurm, ProbeJobStopsWhenNodesCannotSeeTheWorkFolder) {
+  if (fs::exists(cluster / "hidden_unsupported"))
+    GTEST_SKIP() << "mount namespaces not permitted here: the fixture could not hide a folder from slurmd";
+  const fs::path hidden = cluster / "hidden" / "probe.work";
+  const auto f = cohort("probe", "backend: slurm\nwork_dir: " + hidden.string() + "\nslurm: {poll_interval_s: 0.2}\n");
+  const auto r = sh("cohort run " + f + " --until centerline");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("the Slurm compute nodes cannot use this cohort: probe job"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("could not read the token file " + (hidden / "slurm/probe_token").string()), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("submitted job array"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(hidden / "cohort_manifest.yaml"));
+  EXPECT_EQ(active_queue(), "");
+}
+
+TEST_F(CohortSlurm, InterruptCancelsSubmittedTasks) {
+  // Hold every task in the queue (--hold), so the interrupt finds them pending.
   const auto f = cohort("cancel", "backend: slurm\nslurm: {extra_sbatch_options: \"--hold\", poll_interval_s: 0.2}\n");
   const fs::path log = dir / "cancel.out";
   const pid_t pid = ::fork();
@@ -170,24 +258,17 @@ TEST_F(CohortSlurm, InterruptCancelsSubmittedJobs) {
   bool submitted = false;
   for (int i = 0; i < 300 && !submitted; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    submitted = fs::exists(log) && read_text(log).find("submitted to Slurm") != std::string::npos;
+    submitted = fs::exists(log) && read_text(log).find("submitted job array") != std::string::npos;
   }
   EXPECT_TRUE(submitted) << read_text(log);
-  const std::string q = queue();
-  EXPECT_EQ(std::count(q.begin(), q.end(), '\n'), 3) << q;
+  EXPECT_EQ(lines(active_queue()), 3) << active_queue();
   ::kill(pid, SIGINT);
   int status = 0;
   ::waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 130) << read_text(log);
-  EXPECT_NE(read_text(log).find("cancelled 3 Slurm job(s)"), std::string::npos) << read_text(log);
-  // Cancelled jobs may still be listed as CANCELLED for a while; none may be pending or running.
-  FILE* p = ::popen("squeue -h -t PENDING,RUNNING,COMPLETING -o %A", "r");
-  char buf[256];
-  std::string active;
-  while (p && std::fgets(buf, sizeof buf, p)) active += buf;
-  if (p) ::pclose(p);
-  EXPECT_EQ(active, "");
+  EXPECT_NE(read_text(log).find("cancelled 3 Slurm task(s)"), std::string::npos) << read_text(log);
+  EXPECT_EQ(active_queue(), "");  // cancelled tasks may be listed as CANCELLED, never pending or running
 }
 
 TEST(CohortSlurmErrors, MissingSbatchIsAClearError) {
@@ -197,14 +278,15 @@ TEST(CohortSlurmErrors, MissingSbatchIsAClearError) {
   const fs::path f = dir / "c.yaml";
   write_atomic(f, "template: patient.yaml\nbackend: slurm\ncases:\n  - id: a\n");
   // An empty PATH: sbatch cannot be found (the binary itself is given by full path).
-  Result r{0, ""};
-  FILE* p = ::popen(("PATH=/nonexistent " + std::string(STENTSIM_TEST_BINARY) + " cohort run " + f.string() + " 2>&1").c_str(), "r");
-  char buf[4096];
-  while (p && std::fgets(buf, sizeof buf, p)) r.out += buf;
-  const int status = p ? ::pclose(p) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  EXPECT_EQ(r.code, 1) << r.out;
-  EXPECT_NE(r.out.find("'sbatch' not found in PATH"), std::string::npos) << r.out;
+  const std::string out = capture("PATH=/nonexistent " + std::string(STENTSIM_TEST_BINARY) + " cohort run " + f.string() + " 2>&1" +
+                                  "; echo exit=$?");
+  EXPECT_NE(out.find("exit=1"), std::string::npos) << out;
+  EXPECT_NE(out.find("'sbatch' not found in PATH"), std::string::npos) << out;
+  // --no-wait without the slurm back-end is an input error (exit 2).
+  write_atomic(f, "template: patient.yaml\ncases:\n  - id: a\n");
+  const auto r = sh("cohort run " + f.string() + " --no-wait");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--no-wait needs the slurm back-end"), std::string::npos) << r.out;
   fs::remove_all(dir);
 }
 

@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# A private single-node Slurm cluster for the cohort tests
-# (recipe: ../shared/notes/slurm-localhost.md): munged + slurmctld + slurmd
-# with a fresh state folder B, on the given ports.
-#   start B CTLD_PORT SLURMD_PORT OWNER_PID   -> writes B/slurm.conf, B/pids
-#   stop B                                    -> cancels jobs, waits, stops the daemons, removes B
-# A watchdog stops the cluster when OWNER_PID (the test process) dies, so a
-# crashed test does not leave daemons behind.
+# The private single-node Slurm cluster shared by every Slurm cohort test
+# (CTest fixture; recipe: ../shared/notes/slurm-localhost.md): munged +
+# slurmctld + slurmd with a fresh state folder B, on ports checked free.
+#   start B  -> writes B/slurm.conf and B/pids (munged, slurmctld, slurmd)
+#   stop B   -> cancels every job, waits for an empty queue, stops those PIDs, removes B
+# slurmd runs in its own mount namespace in which B/hidden is an empty tmpfs:
+# a work folder under B/hidden is invisible to the jobs, as on a cluster whose
+# compute nodes do not mount it (the probe-job test). A watchdog stops the
+# cluster when the owner (ctest, the parent) dies, so nothing is left behind.
+# Missing Slurm: exit 77 (skipped) with the reason, unless CI is set (exit 1).
 set -u
 cmd=$1; B=$2
 
@@ -27,8 +30,26 @@ stop() {
 
 if [ "$cmd" = stop ]; then stop; exit 0; fi
 
-ctld_port=$3; slurmd_port=$4; owner=$5
-rm -rf "$B"; mkdir -p "$B/munge" "$B/state" "$B/spool" "$B/log"; chmod 755 "$B" "$B/munge"
+for tool in munged mungekey slurmctld slurmd sbatch squeue scancel scontrol sinfo; do
+  if ! command -v "$tool" >/dev/null 2>&1; then
+    msg="Slurm not installed ('$tool' missing; Debian packages slurmctld slurmd slurm-client munge, scripts/install-deps.sh)"
+    if [ -n "${CI:-}" ]; then echo "CI is set: $msg"; exit 1; fi
+    echo "SKIPPED: $msg"; exit 77
+  fi
+done
+# A TCP port nobody on this machine uses (bound or connected), from /proc/net/tcp*.
+port_in_use() { grep -qi ":$(printf '%04X' "$1") " /proc/net/tcp /proc/net/tcp6 2>/dev/null; }
+free_port() {
+  local p
+  for _ in $(seq 1 200); do
+    p=$((20000 + RANDOM % 30000))
+    port_in_use "$p" || [ "$p" = "${1:-0}" ] || { echo "$p"; return; }
+  done
+  echo "no free port found" >&2; exit 1
+}
+ctld_port=$(free_port); slurmd_port=$(free_port "$ctld_port"); owner=$PPID
+[ -f "$B/pids" ] && "$0" stop "$B"
+rm -rf "$B"; mkdir -p "$B/munge" "$B/state" "$B/spool" "$B/log" "$B/hidden"; chmod 755 "$B" "$B/munge"
 cpus=$(nproc)
 cat > "$B/slurm.conf" <<EOF
 ClusterName=stentsimtest
@@ -58,19 +79,30 @@ PartitionName=debug Nodes=localhost Default=YES MaxTime=INFINITE State=UP
 EOF
 export SLURM_CONF=$B/slurm.conf
 mungekey --create --keyfile="$B/munge/munge.key" >/dev/null 2>&1 || { echo "mungekey failed"; exit 1; }
-munged -F --socket="$B/munge/munge.socket.2" --key-file="$B/munge/munge.key" --log-file="$B/log/munged.log" \
+setsid munged -F --socket="$B/munge/munge.socket.2" --key-file="$B/munge/munge.key" --log-file="$B/log/munged.log" \
   --pid-file="$B/munge/munged.pid" --seed-file="$B/munge/munged.seed" </dev/null >/dev/null 2>&1 &
 echo $! > "$B/pids"
 for _ in $(seq 1 100); do [ -S "$B/munge/munge.socket.2" ] && break; sleep 0.05; done
 [ -S "$B/munge/munge.socket.2" ] || { echo "munged did not start: $(tail -3 "$B/log/munged.log")"; stop; exit 1; }
 setsid slurmctld -D -c -f "$SLURM_CONF" </dev/null >"$B/log/slurmctld.out" 2>&1 &
 echo $! >> "$B/pids"
-setsid slurmd -D -N localhost -f "$SLURM_CONF" </dev/null >"$B/log/slurmd.out" 2>&1 &
+# slurmd (and so every job) in a private mount namespace with B/hidden over-mounted;
+# where namespaces are not permitted, plain slurmd and B/hidden_unsupported says so.
+if unshare -m --propagation private true 2>/dev/null; then
+  setsid unshare -m --propagation private sh -c 'mount -t tmpfs -o size=1m none "$1/hidden" && exec slurmd -D -N localhost -f "$1/slurm.conf"' \
+    sh "$B" </dev/null >"$B/log/slurmd.out" 2>&1 &
+else
+  touch "$B/hidden_unsupported"
+  setsid slurmd -D -N localhost -f "$SLURM_CONF" </dev/null >"$B/log/slurmd.out" 2>&1 &
+fi
 echo $! >> "$B/pids"
-( while kill -0 "$owner" 2>/dev/null; do sleep 1; done; "$0" stop "$B" ) </dev/null >/dev/null 2>&1 &
+setsid bash -c 'while kill -0 "$1" 2>/dev/null; do sleep 1; done; "$2" stop "$3"' watchdog "$owner" "$0" "$B" </dev/null >/dev/null 2>&1 &
 echo $! > "$B/watchdog.pid"
 for _ in $(seq 1 300); do
-  [ "$(sinfo -h -o %t 2>/dev/null)" = idle ] && exit 0
+  if [ "$(sinfo -h -o %t 2>/dev/null)" = idle ]; then
+    echo "Slurm cluster up: SLURM_CONF=$B/slurm.conf ports $ctld_port/$slurmd_port PIDs $(tr '\n' ' ' < "$B/pids")"
+    exit 0
+  fi
   sleep 0.1
 done
 echo "Slurm node did not become idle in 30 s; slurmctld: $(tail -3 "$B/log/slurmctld.log" 2>/dev/null); slurmd: $(tail -3 "$B/log/slurmd.log" 2>/dev/null)"

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <iostream>
+#include <optional>
 
 #include "common/error.hpp"
 #include "pipeline/runner.hpp"
@@ -39,7 +40,11 @@ int cohort_status(const std::string& file) {
   const auto c = workflows::load_cohort(file);
   const auto case_files = workflows::materialize_cases(c);
   std::cout << fmt::format("{:<20}", "case");
+  // Slurm: the task of each case and where it stands (squeue for pending/running).
+  std::optional<std::vector<workflows::SlurmCaseState>> slurm;
+  if (workflows::has_slurm_jobs(c)) slurm = workflows::slurm_case_states(c);
   for (const auto& s : workflows::all_stage_names()) std::cout << fmt::format(" {:<12}", s);
+  if (slurm) std::cout << fmt::format(" {:<12} {}", "slurm task", "slurm state");
   std::cout << "\n";
   for (std::size_t i = 0; i < c.cases.size(); ++i) {
     const auto cc = workflows::load_case(case_files[i]);
@@ -53,8 +58,13 @@ int cohort_status(const std::string& file) {
     std::cout << fmt::format("{:<20}", c.cases[i].id);
     for (const auto& s : workflows::all_stage_names())
       std::cout << fmt::format(" {:<12}", state.count(s) ? state[s] : "");
+    if (slurm) std::cout << fmt::format(" {:<12} {}", (*slurm)[i].job, (*slurm)[i].state);
     std::cout << "\n";
   }
+  // Failures and lost tasks with their messages (the tail of run.log or of the Slurm output).
+  if (slurm)
+    for (const auto& s : *slurm)
+      if (!s.detail.empty()) std::cout << fmt::format("{}: {}: {}\n", s.id, s.state, s.detail);
   return 0;
 }
 
@@ -66,7 +76,7 @@ void register_cohort(CLI::App& app) {
   struct Args {
     std::string file, cases, until, only;
     std::string force, backend;
-    bool dry_run = false;
+    bool dry_run = false, no_wait = false;
     int workers = 0;
   };
   auto a = std::make_shared<Args>();
@@ -79,12 +89,16 @@ void register_cohort(CLI::App& app) {
   run->add_option("--only", a->only, "Run only this stage of each case");
   auto* force = run->add_option("--force", a->force, "Re-run every stage, or only STAGE")->expected(0, 1);
   run->add_flag("--dry-run", a->dry_run, "Print each case's plan; run nothing");
-  run->add_option("--backend", a->backend, "local (worker pool) or slurm (one batch job per case); default: the cohort file's")
+  run->add_option("--backend", a->backend, "local (worker pool) or slurm (one job array); default: the cohort file's")
       ->check(CLI::IsMember({"local", "slurm"}));
+  run->add_flag("--no-wait", a->no_wait, "slurm: submit and return; follow with `cohort status`");
   on(run, [a, force] {
     auto c = workflows::load_cohort(a->file);
     if (!a->backend.empty()) c.backend = a->backend;
+    if (a->no_wait && c.backend != "slurm")
+      throw InputError(fmt::format("{}: --no-wait needs the slurm back-end (backend: slurm or --backend slurm)", c.file.string()));
     workflows::CohortRunOptions o;
+    o.no_wait = a->no_wait;
     o.workers = a->workers;
     o.only_cases = split(a->cases);
     o.binary = self_binary();
@@ -96,6 +110,7 @@ void register_cohort(CLI::App& app) {
     }
     if (a->dry_run) o.run_args.push_back("--dry-run");
     const auto rep = c.backend == "slurm" ? workflows::run_cohort_slurm(c, o, std::cout) : workflows::run_cohort(c, o, std::cout);
+    if (!rep.waited) return 0;
     workflows::write_cohort_summary(c, rep);
     std::cout << fmt::format("{} cases: {} as expected, {} unexpected failures; summary: {}\n", rep.cases.size(),
                              rep.cases.size() - static_cast<std::size_t>(rep.unexpected()), rep.unexpected(),
@@ -107,7 +122,7 @@ void register_cohort(CLI::App& app) {
     return rep.exit_code();
   });
   auto file = std::make_shared<std::string>();
-  auto* status = cohort->add_subcommand("status", "Table of cases x stages (done, stale, failed)");
+  auto* status = cohort->add_subcommand("status", "Table of cases x stages (done, stale, failed) and, for Slurm, each case's task and state");
   status->add_option("cohort", *file, "Cohort file (YAML)")->required();
   on(status, [file] { return cohort_status(*file); });
 }

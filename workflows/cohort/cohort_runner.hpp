@@ -17,6 +17,7 @@ struct CohortRunOptions {
   std::vector<std::string> only_cases;  // --cases
   std::vector<std::string> run_args;    // passed to each `stentsim run` (--until, --only, --force, --dry-run)
   std::string binary;                   // the stentsim executable
+  bool no_wait = false;                 // slurm: submit and return (`cohort status` follows)
 };
 
 struct CaseOutcome {
@@ -31,6 +32,7 @@ struct CaseOutcome {
 
 struct CohortReport {
   std::vector<CaseOutcome> cases;
+  bool waited = true;  // false: submitted with --no-wait, outcomes not known yet
   int unexpected() const;
   int exit_code() const { return unexpected() ? 1 : 0; }
 };

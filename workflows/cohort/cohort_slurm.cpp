@@ -5,22 +5,29 @@
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <ostream>
+#include <random>
 #include <set>
 #include <sstream>
 #include <thread>
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "pipeline/manifest.hpp"
+#include "pipeline/runner.hpp"
+#include "workflows/case_config.hpp"
+#include "workflows/case_stages.hpp"
+#include "workflows/version.hpp"
 
 namespace fs = std::filesystem;
 
@@ -29,6 +36,8 @@ namespace {
 
 volatile std::sig_atomic_t g_slurm_stop = 0;
 extern "C" void on_slurm_stop(int sig) { g_slurm_stop = sig; }
+
+const char* const kLost = "failed (lost: time, memory or node)";
 
 // Single quotes for bash: 'it'\''s'.
 std::string sh_quote(const std::string& s) {
@@ -65,7 +74,7 @@ CommandResult run_command(const std::vector<std::string>& argv_s) {
     ::close(fds[0]);
     ::close(fds[1]);
     std::vector<char*> argv;
-    for (auto s : argv_s) argv.push_back(::strdup(s.c_str()));
+    for (const auto& s : argv_s) argv.push_back(::strdup(s.c_str()));
     argv.push_back(nullptr);
     ::execvp(argv[0], argv.data());
     std::perror(argv_s[0].c_str());
@@ -95,12 +104,13 @@ std::string trim(std::string s) {
 
 std::string tail_of(const fs::path& file, int n) {
   std::ifstream in(file);
+  if (!in) return "(no Slurm output file " + file.string() + ")";
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   std::string out;
   const std::size_t from = lines.size() > static_cast<std::size_t>(n) ? lines.size() - static_cast<std::size_t>(n) : 0;
   for (std::size_t i = from; i < lines.size(); ++i) out += (out.empty() ? "" : " | ") + lines[i];
-  return out;
+  return out.empty() ? "(empty Slurm output " + file.string() + ")" : out;
 }
 
 // States in which a job still holds (or waits for) resources.
@@ -111,29 +121,29 @@ bool active_state(const std::string& s) {
   return active.count(s) > 0;
 }
 
-// Job id -> state for the given jobs; a job missing from the map has left the queue.
-std::map<std::string, std::string> job_states(const std::vector<std::string>& ids) {
+// Task id ("123_4") -> state for every task of the given array jobs that
+// squeue still lists; a task missing from the map has left the queue.
+std::map<std::string, std::string> task_states(const std::set<std::string>& arrays) {
   std::map<std::string, std::string> states;
-  if (ids.empty()) return states;
-  std::string list;
-  for (const auto& id : ids) list += (list.empty() ? "" : ",") + id;
-  const auto r = run_command({"squeue", "-h", "-t", "all", "-j", list, "-o", "%i %T"});
-  if (r.code != 0) {
-    // squeue rejects a list in which every job has been purged already.
-    if (r.output.find("Invalid job id") != std::string::npos) return states;
-    throw ComputeError("cohort (slurm): squeue failed (exit " + std::to_string(r.code) + "): " + trim(r.output));
+  for (const auto& a : arrays) {  // one query per array: squeue rejects a list once one id is purged
+    const auto r = run_command({"squeue", "-h", "-r", "-t", "all", "-j", a, "-o", "%i %T"});
+    if (r.code != 0) {
+      if (r.output.find("Invalid job id") != std::string::npos) continue;  // purged: every task left
+      throw ComputeError("cohort (slurm): squeue failed (exit " + std::to_string(r.code) + "): " + trim(r.output));
+    }
+    std::istringstream in(r.output);
+    for (std::string id, state; in >> id >> state;) states[id] = state;
   }
-  std::istringstream in(r.output);
-  for (std::string id, state; in >> id >> state;) states[id] = state;
   return states;
 }
 
-void cancel(const std::vector<std::string>& ids, std::ostream& out) {
-  if (ids.empty()) return;
+void cancel(const std::vector<std::string>& tasks, std::ostream& out) {
+  if (tasks.empty()) return;
   std::vector<std::string> argv = {"scancel"};
-  argv.insert(argv.end(), ids.begin(), ids.end());
+  argv.insert(argv.end(), tasks.begin(), tasks.end());
   const auto r = run_command(argv);
-  out << fmt::format("cancelled {} Slurm job(s){}\n", ids.size(), r.code ? ": scancel said " + trim(r.output) : "");
+  out << fmt::format("cancelled {} Slurm task(s){}\n", tasks.size(), r.code ? ": scancel said " + trim(r.output) : "");
+  out.flush();
 }
 
 void sleep_interruptibly(double seconds) {
@@ -141,66 +151,310 @@ void sleep_interruptibly(double seconds) {
   while (!g_slurm_stop && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(50));
 }
 
-}  // namespace
+// ---- the cohort manifest: which Slurm task ran (or runs) each case -------
 
-std::string slurm_batch_script(const CohortConfig& c, const CohortCase& k, const std::string& binary,
-                               const fs::path& case_file, const std::vector<std::string>& run_args) {
-  const fs::path dir = c.work_dir / k.id;
-  std::string cmd = sh_quote(binary) + " run " + sh_quote(case_file.string());
-  for (const auto& a : run_args) cmd += " " + sh_quote(a);
-  // The exit code file is written atomically (temp + rename) as the job's
-  // last act: its absence after the job left the queue means the job was lost.
-  return fmt::format(
-      "#!/bin/bash\n"
-      "# generated by stentsim cohort (slurm back-end) for case '{}' of {}; do not edit\n"
-      "export OMP_NUM_THREADS=1\n"
-      "cd {} || exit 2\n"
-      "{} > {} 2>&1\n"
-      "rc=$?\n"
-      "echo $rc > {} && mv -f {} {}\n"
-      "exit $rc\n",
-      k.id, c.file.string(), sh_quote(dir.string()), cmd, sh_quote((dir / "run.log").string()),
-      sh_quote((dir / ".exit_code.tmp").string()), sh_quote((dir / ".exit_code.tmp").string()),
-      sh_quote((dir / "exit_code").string()));
+struct TaskRecord {
+  std::string job;    // "123_4"
+  std::string array;  // "123"
+  fs::path output;    // the task's Slurm output file
+  std::vector<std::string> run_args;
+  std::string submitted;  // ISO 8601 UTC
+};
+
+fs::path manifest_path(const CohortConfig& c) { return c.work_dir / "cohort_manifest.yaml"; }
+
+std::map<std::string, TaskRecord> load_tasks(const CohortConfig& c) {
+  std::map<std::string, TaskRecord> tasks;
+  const fs::path f = manifest_path(c);
+  if (!fs::exists(f)) return tasks;
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(f.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(fmt::format("{}: unreadable cohort manifest ({}); delete it to start afresh", f.string(), e.what()));
+  }
+  for (const auto& kv : root["slurm_tasks"]) {
+    TaskRecord t;
+    t.job = kv.second["job"].as<std::string>("");
+    t.array = kv.second["array_job"].as<std::string>("");
+    t.output = kv.second["output"].as<std::string>("");
+    t.submitted = kv.second["submitted"].as<std::string>("");
+    for (const auto& a : kv.second["run_args"]) t.run_args.push_back(a.as<std::string>());
+    if (!t.job.empty()) tasks[kv.first.as<std::string>()] = t;
+  }
+  return tasks;
 }
 
-std::vector<std::string> sbatch_arguments(const CohortConfig& c, const CohortCase& k) {
-  const fs::path dir = c.work_dir / k.id;
-  std::vector<std::string> a = {"--parsable",
-                                "--job-name=stentsim-" + c.name + "-" + k.id,
-                                "--output=" + (dir / "slurm-%j.out").string(),
-                                "--chdir=" + dir.string(),
-                                "--ntasks=" + std::to_string(c.ranks_per_case),
-                                "--cpus-per-task=" + std::to_string(c.slurm.cpus_per_case)};
+void save_tasks(const CohortConfig& c, const std::map<std::string, TaskRecord>& tasks) {
+  YAML::Emitter e;
+  e << YAML::Comment("written by stentsim cohort run (slurm back-end): the Slurm task of each case");
+  e << YAML::BeginMap << YAML::Key << "cohort" << YAML::Value << c.file.string();
+  e << YAML::Key << "slurm_tasks" << YAML::Value << YAML::BeginMap;
+  for (const auto& [id, t] : tasks) {
+    e << YAML::Key << id << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "job" << YAML::Value << YAML::DoubleQuoted << t.job;
+    e << YAML::Key << "array_job" << YAML::Value << YAML::DoubleQuoted << t.array;
+    e << YAML::Key << "output" << YAML::Value << t.output.string();
+    e << YAML::Key << "submitted" << YAML::Value << t.submitted;
+    e << YAML::Key << "run_args" << YAML::Value << YAML::Flow << t.run_args;
+    e << YAML::EndMap;
+  }
+  e << YAML::EndMap << YAML::EndMap;
+  files::write_atomic(manifest_path(c), std::string(e.c_str()) + "\n");
+}
+
+// The exit code a task wrote as its last act ("<rc> <task id>"), if that
+// file belongs to `job`.
+std::optional<int> task_exit_code(const CohortConfig& c, const std::string& id, const std::string& job) {
+  std::ifstream in(c.work_dir / id / "exit_code");
+  int rc = 0;
+  std::string who;
+  if (in >> rc >> who && who == job) return rc;
+  return std::nullopt;
+}
+
+// The outcome of a task that left the queue (nullopt: no exit-code file yet).
+std::optional<CaseOutcome> finished_outcome(const CohortConfig& c, const CohortCase& k, const TaskRecord& t, double wall) {
+  if (auto rc = task_exit_code(c, k.id, t.job)) return case_outcome(c, k, *rc, wall);
+  return std::nullopt;
+}
+
+CaseOutcome lost_outcome(const CohortCase& k, const TaskRecord& t, const std::string& state, double wall) {
+  CaseOutcome r;
+  r.id = k.id;
+  r.wall_s = wall;
+  r.exit_code = 1;
+  r.status = "failed";
+  r.message = fmt::format("lost: time, memory or node (Slurm task {} {}); Slurm output: {}", t.job, state,
+                          tail_of(t.output, 3));
+  return r;
+}
+
+// True when a case's recorded run needs no new submission: it ended as
+// expected with the same run arguments and none of its stages is stale (its
+// inputs, configuration or the tool changed) or failed unexpectedly.
+bool up_to_date(const CohortConfig& c, const CohortCase& k, const fs::path& case_file, const TaskRecord& t,
+                const std::vector<std::string>& run_args) {
+  if (t.run_args != run_args) return false;
+  const auto rc = task_exit_code(c, k.id, t.job);
+  if (!rc) return false;
+  const CaseOutcome o = case_outcome(c, k, *rc, 0);
+  if (!o.as_expected()) return false;
+  const auto cc = load_case(case_file);
+  pipeline::Runner runner(pipeline::Plan(stages_for(cc), cc.work_dir), kVersion);
+  for (const auto& s : runner.status()) {
+    if (s.state == pipeline::StageState::stale) return false;
+    if (s.state == pipeline::StageState::failed && o.status != "failed as expected") return false;
+  }
+  return true;
+}
+
+std::string random_token() {
+  std::random_device rd;
+  return fmt::format("stentsim-probe-{:08x}{:08x}-{}", rd(), rd(), ::getpid());
+}
+
+// sbatch options shared by the probe and the array: where and how long.
+std::vector<std::string> placement_options(const CohortConfig& c) {
+  std::vector<std::string> a;
   if (!c.slurm.partition.empty()) a.push_back("--partition=" + c.slurm.partition);
   if (!c.slurm.time_limit.empty()) a.push_back("--time=" + c.slurm.time_limit);
+  return a;
+}
+
+// The probe: one task that reads a token file from the work folder and checks
+// the binary; its exit code says what the compute node could not see.
+void probe(const CohortConfig& c, const std::string& binary, std::ostream& out) {
+  const fs::path dir = c.work_dir / "slurm";
+  const fs::path token_file = dir / "probe_token";
+  const std::string token = random_token();
+  files::write_atomic(token_file, token + "\n");
+  const fs::path script = dir / "probe.sh";
+  files::write_atomic(script, fmt::format("#!/bin/bash\n"
+                                          "# generated by stentsim cohort: can a compute node see the work folder?\n"
+                                          "[ -r {0} ] || exit 3\n"
+                                          "[ \"$(cat {0})\" = {1} ] || exit 4\n"
+                                          "[ -x {2} ] || exit 5\n"
+                                          "exit 0\n",
+                                          sh_quote(token_file.string()), sh_quote(token), sh_quote(binary)));
+  // Output to /dev/null and chdir to /: the probe must not need the folder it tests.
+  std::vector<std::string> argv = {"sbatch", "--parsable", "--job-name=stentsim-probe-" + c.name, "--output=/dev/null",
+                                   "--chdir=/", "--ntasks=1"};
+  const auto place = placement_options(c);
+  argv.insert(argv.end(), place.begin(), place.end());
+  // The cohort's extra options (account, qos, ...) apply too, but never a hold: the runner waits for the probe.
+  for (const auto& x : c.slurm.extra_options)
+    if (x != "--hold" && x != "-H") argv.push_back(x);
+  argv.push_back(script.string());
+  const auto r = run_command(argv);
+  const std::string job = trim(r.output).substr(0, trim(r.output).find(';'));
+  if (r.code != 0 || job.empty() || job.find_first_not_of("0123456789") != std::string::npos)
+    throw ComputeError(fmt::format("{}: probe job: sbatch failed (exit {}): {}", c.file.string(), r.code, trim(r.output)));
+  out << fmt::format("probe job {}: can the compute nodes see {}?\n", job, c.work_dir.string());
+  out.flush();
+  std::string state, exit_code;
+  for (;;) {
+    if (g_slurm_stop) {
+      cancel({job}, out);
+      throw Interrupted();
+    }
+    const auto s = run_command({"scontrol", "-o", "show", "job", job});
+    auto field = [&](const std::string& key) {
+      const auto p = s.output.find(" " + key + "=");
+      if (p == std::string::npos) return std::string();
+      const auto b = p + key.size() + 2;
+      return s.output.substr(b, s.output.find_first_of(" \n", b) - b);
+    };
+    state = field("JobState");
+    exit_code = field("ExitCode");
+    if (s.code != 0)
+      throw ComputeError(fmt::format("{}: probe job {}: scontrol failed: {}", c.file.string(), job, trim(s.output)));
+    if (!state.empty() && !active_state(state)) break;
+    sleep_interruptibly(std::min(c.slurm.poll_interval_s, 0.5));
+  }
+  const int rc = std::atoi(exit_code.c_str());  // "3:0" -> 3
+  if (state == "COMPLETED" && rc == 0) return;
+  const std::string why = rc == 3   ? fmt::format("could not read the token file {}", token_file.string())
+                          : rc == 4 ? fmt::format("read a different token from {} (another file system?)", token_file.string())
+                          : rc == 5 ? fmt::format("could not execute the stentsim binary {}", binary)
+                                    : fmt::format("ended {} with exit code {}", state, exit_code);
+  throw ComputeError(fmt::format(
+      "{}: the Slurm compute nodes cannot use this cohort: probe job {} {}. The work folder ({}) and the stentsim "
+      "binary must be on a file system the compute nodes share (set work_dir in the cohort file)",
+      c.file.string(), job, why, c.work_dir.string()));
+}
+
+std::string utc_now() { return pipeline::utc_now_iso8601(); }
+
+}  // namespace
+
+std::string slurm_array_script(const CohortConfig& c, const std::vector<std::string>& ids, const std::string& binary,
+                               const std::vector<std::string>& run_args) {
+  std::string cases;
+  for (const auto& id : ids) cases += " " + sh_quote(id);
+  std::string cmd = sh_quote(binary) + " run case.yaml";
+  for (const auto& a : run_args) cmd += " " + sh_quote(a);
+  // The serial stages run once per task; an MPI stage launches its ranks over
+  // the task's allocation (--ntasks) with this launcher (mpirun as root needs
+  // --allow-run-as-root; Debian's OpenMPI does not work with srun --mpi=pmi2).
+  const std::string mpi =
+      c.ranks_per_case > 1
+          ? "export STENTSIM_MPI_LAUNCH=\"mpirun --allow-run-as-root --oversubscribe -np ${SLURM_NTASKS:-" +
+                std::to_string(c.ranks_per_case) + "}\"\n"
+          : "";
+  // The exit-code file ("<rc> <task id>", temp + rename) is the task's last
+  // act: its absence after the task left the queue means the task was lost.
+  return fmt::format(
+      "#!/bin/bash\n"
+      "# generated by stentsim cohort (slurm back-end) for {}; do not edit\n"
+      "cases=({} )\n"
+      "id=${{cases[$SLURM_ARRAY_TASK_ID]}}\n"
+      "task=${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}\n"
+      "echo \"stentsim cohort task $task: case $id on $(hostname)\"\n"
+      "export OMP_NUM_THREADS=1\n"
+      "{}"
+      "cd {}/\"$id\" || exit 2\n"
+      "{} > run.log 2>&1\n"
+      "rc=$?\n"
+      "echo \"$rc $task\" > .exit_code.tmp && mv -f .exit_code.tmp exit_code\n"
+      "echo \"case $id: exit $rc\"\n"
+      "exit $rc\n",
+      c.file.string(), cases, mpi, sh_quote(c.work_dir.string()), cmd);
+}
+
+std::vector<std::string> sbatch_array_arguments(const CohortConfig& c, std::size_t n, const fs::path& output_dir) {
+  std::vector<std::string> a = {"--parsable",
+                                "--job-name=stentsim-" + c.name,
+                                "--array=0-" + std::to_string(n - 1),
+                                "--output=" + (output_dir / "slurm-%A_%a.out").string(),
+                                "--chdir=" + c.work_dir.string(),
+                                "--ntasks=" + std::to_string(c.ranks_per_case),
+                                "--cpus-per-task=" + std::to_string(c.slurm.cpus_per_case)};
+  const auto place = placement_options(c);
+  a.insert(a.end(), place.begin(), place.end());
   if (!c.slurm.memory.empty()) a.push_back("--mem=" + c.slurm.memory);
   a.insert(a.end(), c.slurm.extra_options.begin(), c.slurm.extra_options.end());
   return a;
 }
 
+bool has_slurm_jobs(const CohortConfig& c) { return !load_tasks(c).empty(); }
+
+std::vector<SlurmCaseState> slurm_case_states(const CohortConfig& c) {
+  const auto tasks = load_tasks(c);
+  std::set<std::string> arrays;
+  for (const auto& [id, t] : tasks) arrays.insert(t.array);
+  std::map<std::string, std::string> states;
+  std::string queue_error;
+  if (find_in_path("squeue").empty()) queue_error = "squeue not found in PATH";
+  else try {
+      states = task_states(arrays);
+    } catch (const ComputeError& e) {
+      queue_error = e.what();
+    }
+  std::vector<SlurmCaseState> out;
+  for (const auto& k : c.cases) {
+    SlurmCaseState s{k.id, "", "not submitted", ""};
+    auto it = tasks.find(k.id);
+    if (it != tasks.end()) {
+      const TaskRecord& t = it->second;
+      s.job = t.job;
+      auto st = states.find(t.job);
+      if (st != states.end() && active_state(st->second)) {
+        std::string lower = st->second;
+        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
+        s.state = lower;
+      } else if (auto o = finished_outcome(c, k, t, 0)) {
+        s.state = o->status;
+        s.detail = o->message;
+      } else if (!queue_error.empty()) {
+        s.state = "unknown";
+        s.detail = queue_error;
+      } else {
+        s.state = kLost;
+        s.detail = lost_outcome(k, t, st == states.end() ? "left the queue" : st->second, 0).message;
+      }
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
 CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out) {
-  for (const char* tool : {"sbatch", "squeue", "scancel"})
+  for (const char* tool : {"sbatch", "squeue", "scancel", "scontrol"})
     if (find_in_path(tool).empty())
       throw ComputeError(fmt::format("{}: backend slurm: '{}' not found in PATH (install the Debian package "
                                      "slurm-client, or use backend: local / --backend local)",
                                      c.file.string(), tool));
   const auto case_files = materialize_cases(c);
   const std::vector<std::size_t> todo = selected_cases(c, o.only_cases);
+  auto tasks = load_tasks(c);
 
-  struct Job {
-    std::size_t index;
-    std::string id;  // Slurm job id
-    std::chrono::steady_clock::time_point submitted;
-    bool finished = false;
-  };
-  std::vector<Job> jobs;
-  auto active_ids = [&] {
-    std::vector<std::string> ids;
-    for (const auto& j : jobs)
-      if (!j.finished) ids.push_back(j.id);
-    return ids;
-  };
+  // What becomes of each selected case: attach to its queued/running task,
+  // keep its finished up-to-date result, or submit it again.
+  std::set<std::string> arrays;
+  for (const std::size_t i : todo)
+    if (auto it = tasks.find(c.cases[i].id); it != tasks.end()) arrays.insert(it->second.array);
+  const auto states = task_states(arrays);
+  const bool always = std::any_of(o.run_args.begin(), o.run_args.end(),
+                                  [](const std::string& a) { return a == "--force" || a == "--dry-run"; });
+  std::vector<std::size_t> attach, submit;
+  std::vector<CaseOutcome> done;
+  for (const std::size_t i : todo) {
+    const auto& k = c.cases[i];
+    auto it = tasks.find(k.id);
+    if (it != tasks.end()) {
+      auto st = states.find(it->second.job);
+      if (st != states.end() && active_state(st->second)) {
+        attach.push_back(i);
+        continue;
+      }
+      if (!always && up_to_date(c, k, case_files[i], it->second, o.run_args)) {
+        done.push_back(*finished_outcome(c, k, it->second, 0));
+        continue;
+      }
+    }
+    submit.push_back(i);
+  }
 
   struct sigaction sa {}, old_int {}, old_term {};
   sa.sa_handler = on_slurm_stop;
@@ -208,99 +462,146 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, 
   g_slurm_stop = 0;
   sigaction(SIGINT, &sa, &old_int);
   sigaction(SIGTERM, &sa, &old_term);
-  auto restore = [&] {
-    sigaction(SIGINT, &old_int, nullptr);
-    sigaction(SIGTERM, &old_term, nullptr);
+  struct Restore {
+    struct sigaction *i, *t;
+    ~Restore() {
+      sigaction(SIGINT, i, nullptr);
+      sigaction(SIGTERM, t, nullptr);
+    }
+  } restore{&old_int, &old_term};
+
+  struct Follow {
+    std::size_t index;
+    std::chrono::steady_clock::time_point since;
+    std::optional<std::chrono::steady_clock::time_point> gone;  // first seen outside the queue without exit code
+    bool finished = false;
+  };
+  std::vector<Follow> follow;
+  const auto now = std::chrono::steady_clock::now();
+  for (const std::size_t i : attach) follow.push_back({i, now, {}});
+  auto active_tasks = [&] {
+    std::vector<std::string> ids;
+    for (const auto& f : follow)
+      if (!f.finished) ids.push_back(tasks.at(c.cases[f.index].id).job);
+    return ids;
   };
 
-  std::string job_list;
-  try {
-    for (const std::size_t i : todo) {
-      if (g_slurm_stop) break;
-      const auto& k = c.cases[i];
-      const fs::path dir = c.work_dir / k.id;
-      fs::remove(dir / "exit_code");
-      const fs::path script = dir / "slurm_job.sh";
-      files::write_atomic(script, slurm_batch_script(c, k, o.binary, case_files[i], o.run_args));
+  out << fmt::format("cohort {}: {} cases: {} to submit, {} queued or running (attached), {} up to date\n", c.name,
+                     todo.size(), submit.size(), attach.size(), done.size());
+  for (const std::size_t i : attach) out << fmt::format("  {}: attached to Slurm task {}\n", c.cases[i].id, tasks.at(c.cases[i].id).job);
+  out.flush();
+
+  if (!submit.empty()) {
+    try {
+      probe(c, o.binary, out);
+      const fs::path sdir = c.work_dir / "slurm";
+      std::vector<std::string> ids;
+      for (const std::size_t i : submit) {
+        ids.push_back(c.cases[i].id);
+        fs::remove(c.work_dir / c.cases[i].id / "exit_code");
+      }
+      const fs::path script = sdir / fmt::format("array-{}-{}.sh", utc_now(), ::getpid());
+      files::write_atomic(script, slurm_array_script(c, ids, o.binary, o.run_args));
       fs::permissions(script, fs::perms::owner_all | fs::perms::group_read | fs::perms::others_read);
       std::vector<std::string> argv = {"sbatch"};
-      const auto args = sbatch_arguments(c, k);
+      const auto args = sbatch_array_arguments(c, ids.size(), sdir);
       argv.insert(argv.end(), args.begin(), args.end());
       argv.push_back(script.string());
       const auto r = run_command(argv);
-      const std::string id = trim(r.output).substr(0, trim(r.output).find(';'));
-      if (r.code != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
-        throw ComputeError(fmt::format("{}: case '{}': sbatch failed (exit {}): {}", c.file.string(), k.id, r.code,
-                                       trim(r.output)));
-      jobs.push_back({i, id, std::chrono::steady_clock::now()});
-      job_list += k.id + " " + id + "\n";
+      const std::string job = trim(r.output).substr(0, trim(r.output).find(';'));
+      if (r.code != 0 || job.empty() || job.find_first_not_of("0123456789") != std::string::npos)
+        throw ComputeError(fmt::format("{}: sbatch of the job array ({} cases: {}{}) failed (exit {}): {}", c.file.string(),
+                                       ids.size(), ids.front(), ids.size() > 1 ? ", ..." : "", r.code, trim(r.output)));
+      const std::string when = utc_now();
+      for (std::size_t t = 0; t < submit.size(); ++t) {
+        TaskRecord rec{job + "_" + std::to_string(t), job, sdir / fmt::format("slurm-{}_{}.out", job, t), o.run_args, when};
+        tasks[c.cases[submit[t]].id] = rec;
+        follow.push_back({submit[t], std::chrono::steady_clock::now(), {}});
+      }
+      save_tasks(c, tasks);
+      out << fmt::format("submitted job array {} ({} task(s) of {} rank(s) x {} cpu(s)): {}\n", job, ids.size(),
+                         c.ranks_per_case, c.slurm.cpus_per_case, script.string());
+      out.flush();
+    } catch (...) {
+      if (!o.no_wait) cancel(active_tasks(), out);
+      throw;
     }
-    files::write_atomic(c.work_dir / "slurm_jobs.txt", job_list);
-  } catch (...) {
-    cancel(active_ids(), out);
-    restore();
-    throw;
   }
-  out << fmt::format("cohort {}: {} cases submitted to Slurm ({} task(s) x {} cpu(s) each)\n", c.name, jobs.size(),
-                     c.ranks_per_case, c.slurm.cpus_per_case);
-  out.flush();
 
-  std::vector<CaseOutcome> done;
+  CohortReport rep;
+  if (o.no_wait) {
+    rep.waited = false;
+    out << fmt::format("not waiting (--no-wait): follow with `stentsim cohort status {}`\n", c.file.string());
+    return rep;
+  }
+
+  // Wait: pending/running from squeue, done/failed from exit-code files and manifests.
+  const std::size_t total = todo.size();
   const auto t0 = std::chrono::steady_clock::now();
+  // A task seen outside the queue without its exit-code file gets a grace period
+  // (a shared file system may show the file late) before it counts as lost.
+  const double grace = std::max(2.0, 3 * c.slurm.poll_interval_s);
+  std::string last_line;
   try {
-    while (!g_slurm_stop && done.size() < jobs.size()) {
-      const auto states = job_states(active_ids());
-      for (auto& j : jobs) {
-        if (j.finished) continue;
-        auto st = states.find(j.id);
-        if (st != states.end() && active_state(st->second)) continue;
-        j.finished = true;
-        const auto& k = c.cases[j.index];
-        const fs::path dir = c.work_dir / k.id;
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - j.submitted).count();
-        CaseOutcome r;
-        std::ifstream ec(dir / "exit_code");
-        int code = 0;
-        if (ec >> code) {
-          r = case_outcome(c, k, code, wall);
-        } else {
-          const std::string state = st == states.end() ? "left the queue" : st->second;
-          r.id = k.id;
-          r.wall_s = wall;
-          r.exit_code = 1;
-          r.status = "failed";
-          r.message = fmt::format("lost (Slurm job {} {}: time, memory or node): {}", j.id, state,
-                                  tail_of(dir / fmt::format("slurm-{}.out", j.id), 3));
+    while (!g_slurm_stop && std::any_of(follow.begin(), follow.end(), [](const Follow& f) { return !f.finished; })) {
+      std::set<std::string> live;
+      for (const auto& f : follow)
+        if (!f.finished) live.insert(tasks.at(c.cases[f.index].id).array);
+      const auto st = task_states(live);
+      int pending = 0, running = 0;
+      for (auto& f : follow) {
+        if (f.finished) continue;
+        const auto& k = c.cases[f.index];
+        const TaskRecord& t = tasks.at(k.id);
+        auto s = st.find(t.job);
+        if (s != st.end() && active_state(s->second)) {
+          (s->second == "PENDING" ? pending : running)++;
+          continue;
         }
-        done.push_back(r);
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - f.since).count();
+        std::optional<CaseOutcome> r = finished_outcome(c, k, t, wall);
+        if (!r) {
+          if (!f.gone) f.gone = std::chrono::steady_clock::now();
+          if (std::chrono::duration<double>(std::chrono::steady_clock::now() - *f.gone).count() < grace) continue;
+          r = lost_outcome(k, t, s == st.end() ? "left the queue" : s->second, wall);
+        }
+        f.finished = true;
+        done.push_back(*r);
         const int unexpected = static_cast<int>(
             std::count_if(done.begin(), done.end(), [](const CaseOutcome& d) { return !d.as_expected(); }));
-        out << fmt::format("[{}/{}] {:<20} {}{}  (job {}, {} unexpected, {:.0f} s elapsed)\n", done.size(), jobs.size(),
-                           r.id, r.status, r.failed_stage.empty() ? "" : " at " + r.failed_stage, j.id, unexpected,
+        out << fmt::format("[{}/{}] {:<20} {}{}  (task {}, {} unexpected, {:.0f} s elapsed)\n", done.size(), total, r->id,
+                           r->status, r->failed_stage.empty() ? "" : " at " + r->failed_stage, t.job, unexpected,
                            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        out.flush();
       }
-      if (done.size() < jobs.size()) sleep_interruptibly(c.slurm.poll_interval_s);
+      const std::string line = fmt::format("slurm: {} pending, {} running, {}/{} finished", pending, running, done.size(), total);
+      if (line != last_line && (pending + running) > 0) out << line << "\n";
+      last_line = line;
+      out.flush();
+      if (std::any_of(follow.begin(), follow.end(), [](const Follow& f) { return !f.finished; }))
+        sleep_interruptibly(c.slurm.poll_interval_s);
     }
   } catch (...) {
-    cancel(active_ids(), out);
-    restore();
+    cancel(active_tasks(), out);
     throw;
   }
   if (g_slurm_stop) {
-    const auto ids = active_ids();
+    const auto ids = active_tasks();
     cancel(ids, out);
-    // Wait (bounded) until the cancelled jobs have left the active states.
+    // Wait (bounded) until the cancelled tasks have left the active states.
+    std::set<std::string> live;
+    for (const auto& f : follow)
+      if (!f.finished) live.insert(tasks.at(c.cases[f.index].id).array);
     for (int i = 0; i < 100; ++i) {
-      const auto states = job_states(ids);
-      if (std::none_of(states.begin(), states.end(), [](const auto& s) { return active_state(s.second); })) break;
+      const auto st = task_states(live);
+      if (std::none_of(ids.begin(), ids.end(), [&](const std::string& id) {
+            auto s = st.find(id);
+            return s != st.end() && active_state(s->second);
+          }))
+        break;
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
-    restore();
     throw Interrupted();
   }
-  restore();
-  CohortReport rep;
   rep.cases = done;
   sort_like_cohort(c, rep.cases);
   return rep;
