@@ -100,6 +100,20 @@ TEST(StabilityRunner, HangIgnoringTermIsKilledWithItsChildren) {
   fs::remove(marker);
 }
 
+TEST(StabilityRunner, HangEndsGrandchildrenInOtherProcessGroups) {
+  // `stentsim run` puts each stage in a process group of its own: a hang must
+  // end those too, even when they ignore SIGTERM.
+  const fs::path marker = fs::temp_directory_path() / ("stentsim_stability_marker2_" + std::to_string(::getpid()));
+  fs::remove(marker);
+  const auto o = run_one(sh_case("own_group", "trap '' TERM; setsid sh -c \"trap '' TERM; sleep 4; touch " + marker.string() +
+                                                  "\" & sleep 30"),
+                         0.3);
+  EXPECT_EQ(o.outcome, "hang");
+  ::sleep(5);
+  EXPECT_FALSE(fs::exists(marker)) << "a grandchild in its own session survived the hang";
+  fs::remove(marker);
+}
+
 TEST(StabilityRunner, NanInOutputsIsDefectEvenOnSuccess) {
   auto o = run_one(sh_case("nan_summary", "printf 'qoi:\\n  r:\\n    value: .nan\\n    unit: mm\\n' > summary.yaml"));
   EXPECT_EQ(o.outcome, "nan");

@@ -9,6 +9,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <thread>
 
@@ -17,6 +18,35 @@
 namespace fs = std::filesystem;
 
 namespace stentsim::study {
+namespace {
+
+/// Every live descendant of `root` (from the ppid fields of /proc/*/stat). A
+/// stage the child started may sit in a process group of its own
+/// (pipeline/stage_process.cpp does that), out of reach of kill(-pgid).
+std::vector<pid_t> descendants(pid_t root) {
+  std::vector<std::pair<pid_t, pid_t>> procs;  // pid, ppid
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::FILE* f = std::fopen((e.path() / "stat").c_str(), "r");
+    if (!f) continue;
+    char buf[512];
+    const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+    std::fclose(f);
+    buf[n] = 0;
+    const char* close = std::strrchr(buf, ')');  // the command name may hold spaces
+    int ppid = 0;
+    if (close && std::sscanf(close + 1, " %*c %d", &ppid) == 1) procs.emplace_back(std::stoi(name), ppid);
+  }
+  std::vector<pid_t> out{root};
+  for (std::size_t i = 0; i < out.size(); ++i)
+    for (const auto& [pid, ppid] : procs)
+      if (ppid == out[i]) out.push_back(pid);
+  out.erase(out.begin());
+  return out;
+}
+
+}  // namespace
 
 ChildRun run_child(const std::vector<std::string>& argv_s, const fs::path& cwd, const fs::path& log, double limit_s) {
   if (argv_s.empty()) throw ComputeError("stability: empty command");
@@ -54,6 +84,7 @@ ChildRun run_child(const std::vector<std::string>& argv_s, const fs::path& cwd, 
   rusage ru{};
   bool term_sent = false;
   std::chrono::steady_clock::time_point term_time;
+  std::vector<pid_t> family;  // the child's descendants when it was stopped
   for (;;) {
     const pid_t w = ::wait4(pid, &status, WNOHANG, &ru);
     if (w == pid) break;
@@ -62,16 +93,23 @@ ChildRun run_child(const std::vector<std::string>& argv_s, const fs::path& cwd, 
     const double elapsed = std::chrono::duration<double>(now - start).count();
     if (!term_sent && elapsed > limit_s) {
       r.timed_out = true;
+      family = descendants(pid);
       ::kill(-pid, SIGTERM);
+      for (pid_t d : family) ::kill(d, SIGTERM);
       term_sent = true;
       term_time = now;
     } else if (term_sent && std::chrono::duration<double>(now - term_time).count() > 2.0) {
+      for (pid_t d : descendants(pid)) family.push_back(d);
       ::kill(-pid, SIGKILL);
+      for (pid_t d : family) ::kill(d, SIGKILL);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(elapsed < 1 ? 5 : 50));
   }
-  // Grandchildren left in the group (a stage the child started) go with it.
-  if (r.timed_out) ::kill(-pid, SIGKILL);
+  // Grandchildren left behind (a stage the child started) go with it.
+  if (r.timed_out) {
+    ::kill(-pid, SIGKILL);
+    for (pid_t d : family) ::kill(d, SIGKILL);
+  }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   r.peak_memory_mb = static_cast<double>(ru.ru_maxrss) / 1024.0;
