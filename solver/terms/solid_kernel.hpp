@@ -65,6 +65,9 @@ struct SolidElement {
         return {PointStatus::fail("degenerate or inverted reference element"), q};
       const double w = E::kRule.weights[q] * det;
       const Mat3 f = fem::deformation_gradient<kNodes>(x_cur, g);
+      // The materials see C only, whose determinant J^2 hides the sign of J:
+      // an inverted point (J = det F <= 0) is caught here (DESIGN.md §7).
+      if (!(f.determinant() > 0.0)) return {PointStatus::fail("J = det F <= 0 (inverted element)"), q};
       const Mat3 c = f.transpose() * f;
       if (auto st = mat.elastic(c, fiber_dirs, s, k ? &d : nullptr); !st.ok) return {st, q};
       if (mat.viscous && history) {
@@ -102,6 +105,7 @@ struct SolidElement {
         return {PointStatus::fail("degenerate or inverted reference element"), q};
       const double w = E::kRule.weights[q] * det;
       const Mat3 f = fem::deformation_gradient<kNodes>(x_cur, g);
+      if (!(f.determinant() > 0.0)) return {PointStatus::fail("J = det F <= 0 (inverted element)"), q};
       if (auto st = mat.elastic(f.transpose() * f, fiber_dirs, s, nullptr); !st.ok) return {st, q};
       if (mat.viscous && history) s += history[q].q;  // committed state: Q of the output step
       cauchy += w * cauchy_from_pk2(f, from_voigt_stress(s));

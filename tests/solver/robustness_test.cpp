@@ -1,0 +1,207 @@
+// Solver robustness (DESIGN.md §7, issue 11 "Stability"):
+//  - a trial state with J <= 0 is a failed iteration: Newton reports it (body
+//    and element named) and leaves u untouched; the stepper cuts the step and
+//    still reaches the end, with finite results equal to a small-step run;
+//  - only a failure at the minimum step stops the run, with that message;
+//  - the tube above its asymptotic pressure stops with "no converged state
+//    beyond p = ..." instead of creeping, and writes the last converged state
+//    (PVD, history.csv, summary.yaml marked failed, status != 0).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include "common/files.hpp"
+#include "common/mesh_data.hpp"
+#include "common/summary.hpp"
+#include "solver/app/solve.hpp"
+#include "solver/fem/boundary_faces.hpp"
+#include "solver/io/generated_meshes.hpp"
+#include "solver/nonlinear/load_stepper.hpp"
+#include "solver/terms/follower_pressure.hpp"
+
+namespace stentsim::solver {
+namespace {
+
+struct Block {
+  Model model;
+  SolidBody* body = nullptr;
+};
+
+// A 1 x 1 x 2 neo-Hooke block (E = 1 MPa, nu = 0.3) in uniaxial strain, clamped
+// at z = 0, follower pressure p on z = 2. At p = 2.5 MPa the first Newton
+// increment from u = 0 (the linear solution, strain p / 1.35 MPa) compresses
+// the block by more than its length: J <= 0.
+std::unique_ptr<Block> make_block(double pressure) {
+  auto b = std::make_unique<Block>();
+  SolidBodySpec spec;
+  spec.name = "block";
+  spec.mesh = box_hex8(1, 1, 2, 1.0, 1.0, 2.0);
+  Material m;
+  m.name = "nh";
+  m.matrix = CoupledNeoHooke::from_young_poisson(1.0, 0.3);
+  spec.materials = {m};
+  spec.cell_material.assign(spec.mesh.num_cells(), 0);
+  const GlobalDof first = b->model.dofs.allocate("block", 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
+  b->body = &b->model.add_term<SolidBody>(spec, first);
+  std::vector<fem::Face> top;
+  for (const auto& f : fem::boundary_faces(b->body->mesh())) {
+    double zmax = -1, zmin = 10;
+    for (int i = 0; i < f.count; ++i) {
+      zmax = std::max(zmax, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
+      zmin = std::min(zmin, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
+    }
+    if (zmin > 2 - 1e-9) top.push_back(f);
+  }
+  b->model.add_term<FollowerPressure>("pressure", *b->body, top, pressure, LoadCurve::ramp(0, 1));
+  b->model.size_constraints();
+  // Uniaxial strain: x, y held everywhere, bottom face clamped. (Free lateral
+  // motion admits mirrored, everted equilibria with J > 0 that a one-step
+  // Newton run can land on; here the only way past the solution is J <= 0.)
+  for (std::size_t n = 0; n < b->body->num_nodes(); ++n)
+    for (int a = 0; a < 3; ++a)
+      if (a < 2 || b->body->mesh().points[n].z() < 1e-9)
+        b->model.constraints.fix(b->body->dof(n, a), [](double) { return 0.0; });
+  return b;
+}
+
+constexpr double kPressure = 2.5;
+
+NewtonSettings no_line_search() {
+  NewtonSettings ns;
+  ns.line_search_steps = 0;  // a bad trial state cannot be rescued by backtracking: the step must be cut
+  ns.residual_tolerance = 1e-11;
+  ns.increment_tolerance = 1e-11;
+  return ns;
+}
+
+TEST(SolverRobustness, InvertedTrialStateIsAFailedIterationNamingTheElement) {
+  auto b = make_block(kPressure);
+  GlobalSystem sys(b->model.constraints);
+  LinearSolverSettings ls;
+  ls.type = "eigen_lu";
+  auto linear = make_linear_solver(ls);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
+  const NewtonResult nr = newton_step(b->model, sys, *linear, u, 1.0, 1.0, no_line_search());
+  EXPECT_FALSE(nr.converged);
+  EXPECT_NE(nr.failure.find("body 'block', element"), std::string::npos) << nr.failure;
+  EXPECT_TRUE(nr.failure.find("J <= 0") != std::string::npos || nr.failure.find("inverted") != std::string::npos)
+      << nr.failure;
+  EXPECT_EQ(u.norm(), 0.0) << "a failed step leaves u at its start value";
+}
+
+TEST(SolverRobustness, InvertedTrialStateLeadsToACutAndTheSameAnswer) {
+  LinearSolverSettings ls;
+  ls.type = "eigen_lu";
+  auto solve = [&](double dt, int* cuts) {
+    auto b = make_block(kPressure);
+    GlobalSystem sys(b->model.constraints);
+    auto linear = make_linear_solver(ls);
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
+    StepperSettings st;
+    st.dt_initial = st.dt_max = dt;
+    *cuts = 0;
+    run_load_steps(b->model, sys, *linear, u, st, no_line_search(), [&](const StepRecord& r) { *cuts += r.cuts; });
+    return u;
+  };
+  int cuts_big = 0, cuts_small = 0;
+  const Eigen::VectorXd big = solve(1.0, &cuts_big);
+  const Eigen::VectorXd small = solve(0.05, &cuts_small);
+  EXPECT_GE(cuts_big, 1) << "the one-step run must have been cut";
+  ASSERT_TRUE(big.allFinite());
+  EXPECT_LT(big.minCoeff(), -0.3) << "the block is compressed";
+  EXPECT_LT((big - small).norm(), 1e-8 * small.norm());
+}
+
+TEST(SolverRobustness, FailureAtTheMinimumStepStopsWithTheElementAndTheLastState) {
+  auto b = make_block(kPressure);
+  GlobalSystem sys(b->model.constraints);
+  LinearSolverSettings ls;
+  ls.type = "eigen_lu";
+  auto linear = make_linear_solver(ls);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
+  StepperSettings st;
+  st.dt_initial = st.dt_max = 1.0;
+  st.dt_min = 0.6;  // the first cut (to 0.5) is already below the minimum step
+  st.describe_load = [](double t) { return "p = " + std::to_string(kPressure * t) + " MPa"; };
+  try {
+    run_load_steps(b->model, sys, *linear, u, st, no_line_search(), [](const StepRecord&) {});
+    ADD_FAILURE() << "no failure";
+  } catch (const LoadStepStall& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("no converged state beyond p = 0.0"), std::string::npos) << w;
+    EXPECT_NE(w.find("dt_min"), std::string::npos) << w;
+    EXPECT_NE(w.find("body 'block', element"), std::string::npos) << w;
+    EXPECT_EQ(e.time, 0.0);
+  }
+  EXPECT_EQ(u.norm(), 0.0) << "u holds the last converged state";
+}
+
+// The quarter tube of examples/tube_inflation.yaml (E = 1 MPa, nu = 0.45,
+// coarse 4 x 12 mesh) at 1.5 x its asymptotic pressure 0.19297 MPa
+// (workflows/study/references/tube_reference.hpp).
+TEST(SolverRobustness, TubeAboveItsAsymptoticPressureStopsCleanly) {
+  const auto dir = std::filesystem::temp_directory_path() / ("stentsim_stall_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::string text = files::read_text(std::filesystem::path(STENTSIM_TEST_SOURCE_DIR) / "examples/tube_inflation.yaml");
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("value: 0.12 MPa", "value: 0.28945538 MPa");
+  replace("radial: 8", "radial: 4");
+  replace("circumferential: 24", "circumferential: 12");
+  files::write_atomic(dir / "scene.yaml", text);
+  SolveOptions o;
+  o.output_dir = dir / "out";
+  const auto t0 = std::chrono::steady_clock::now();
+  const int status = solve_scene(dir / "scene.yaml", o);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_NE(status, 0);
+  EXPECT_LT(seconds, 60.0) << "the stepper crept instead of stopping";
+
+  const Summary s = Summary::read(dir / "out/summary.yaml");
+  EXPECT_EQ(std::get<std::string>(s.qois().at("status").value), "failed");
+  // The failure note (summary.yaml notes have no reader accessor): its line of the file.
+  const std::string yaml = files::read_text(dir / "out/summary.yaml");
+  const auto note = yaml.find("failure:");
+  ASSERT_NE(note, std::string::npos) << yaml;
+  const std::string failure = yaml.substr(note, yaml.find('\n', note) - note);
+  const std::string key = "no converged state beyond p = ";
+  const auto at = failure.find(key);
+  ASSERT_NE(at, std::string::npos) << failure;
+  const double p = std::stod(failure.substr(at + key.size()));
+  std::printf("stopped at p = %.6f MPa (asymptotic 0.192970) after %.1f s: %s\n", p, seconds, failure.c_str());
+  EXPECT_GT(p, 0.185);
+  EXPECT_LT(p, 0.1935);
+  EXPECT_NE(failure.find("load factor"), std::string::npos);
+
+  // The last converged state is the last frame, the last history row and final_time.
+  const double t_final = std::get<double>(s.qois().at("final_time").value);
+  std::istringstream hist(files::read_text(dir / "out/history.csv"));
+  std::string line, last;
+  while (std::getline(hist, line))
+    if (!line.empty()) last = line;
+  const double t_hist = std::stod(last.substr(last.find(',') + 1));
+  EXPECT_NEAR(t_hist, t_final, 1e-9);
+  const std::string pvd = files::read_text(dir / "out/results.pvd");
+  const auto ts = pvd.rfind("timestep=\"");
+  ASSERT_NE(ts, std::string::npos);
+  EXPECT_NEAR(std::stod(pvd.substr(ts + 10)), t_final, 1e-9);
+  const auto file_at = pvd.find("file=\"", ts) + 6;
+  const MeshData frame = read_vtu((dir / "out" / pvd.substr(file_at, pvd.find('"', file_at) - file_at)).string());
+  for (const auto& [name, a] : frame.point_data)
+    for (double v : a.values) ASSERT_TRUE(std::isfinite(v)) << name;
+  for (const auto& [name, a] : frame.cell_data)
+    for (double v : a.values) ASSERT_TRUE(std::isfinite(v)) << name;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace stentsim::solver
