@@ -114,9 +114,6 @@ TEST_F(DeviceCli, EachStageRunsAloneWithAndWithoutPlacement) {
   EXPECT_EQ(qoi(dir / "b0/summary.yaml", "balloon_elements"), 1276);
   // 18 mm: the default target size gives 29 x 84 = 2,436 hex8; the paper's 2,765 is 35 x 79.
   stentsim::files::write_atomic(dir / "long.yaml", "balloon: {length: 18 mm}\nstent: {rings: 11}\n");
-  r = run_stentsim("balloon --device " + d + "/long.yaml --out " + d + "/b1/balloon.vtu");
-  ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_EQ(qoi(dir / "b1/summary.yaml", "balloon_elements"), 2436);
   stentsim::files::write_atomic(dir / "paper18.yaml",
                                 "balloon: {length: 18 mm, elements_around: 35, elements_along: 79}\n");
   r = run_stentsim("balloon --device " + d + "/paper18.yaml --out " + d + "/b3/balloon.vtu");

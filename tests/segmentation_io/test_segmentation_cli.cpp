@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "common/files.hpp"
 #include "common/mesh_data.hpp"
@@ -87,6 +90,51 @@ TEST_F(SegmentationCli, MetreSurfaceInAMillimetreCaseIsReported) {
   EXPECT_TRUE(fs::exists(dir / "out" / "lumen.vtp"));
   EXPECT_TRUE(fs::exists(dir / "out" / "wall.vtp"));
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.yaml"));
+}
+
+// `stentsim run` on patient cases whose input is a SimVascular .pth/.ctgr pair
+// (the straight fixture) and a NRRD label image (a labelled cylinder with an
+// oblique "space directions"): segmentation and centerline produce lumen.vtp,
+// wall.vtp and centerline.vtp.
+TEST_F(SegmentationCli, RunMakesLumenWallAndCenterlineFromSimVascularAndLabelImage) {
+  const fs::path data = fs::path(STENTSIM_TEST_SOURCE_DIR) / "tests/segmentation_io/data";
+  stentsim::files::write_atomic(dir / "sv.yaml", "name: sv\nscene: patient\ninput:\n  simvascular:\n    path: " +
+                                                     (data / "straight_lad.pth").string() + "\n    lumen: " +
+                                                     (data / "straight_lad_lumen.ctgr").string() + "\n    wall: " +
+                                                     (data / "straight_lad_wall.ctgr").string() + "\n");
+  // Lumen label 1 (r < 1.2 mm) and wall label 2 (r < 1.8 mm) along index axis k, 0.1 mm voxels.
+  const int n[3] = {40, 40, 100};
+  std::vector<unsigned char> v(std::size_t(n[0]) * n[1] * n[2], 0);
+  for (int k = 5; k < 95; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        const double r = 0.1 * std::hypot(i - 19.5, j - 19.5);
+        v[std::size_t(i + n[0] * (j + n[1] * k))] = r < 1.2 ? 1 : (r < 1.8 ? 2 : 0);
+      }
+  {
+    std::ofstream f(dir / "labels.nrrd", std::ios::binary);
+    f << "NRRD0004\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\nsizes: 40 40 100\n"
+         "space directions: (0,0.1,0) (0,0,0.1) (0.1,0,0)\nspace origin: (5,6,7)\nencoding: raw\n\n";
+    f.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size()));
+  }
+  stentsim::files::write_atomic(dir / "img.yaml", "name: img\nscene: patient\ninput:\n  label_image:\n    file: " +
+                                                      (dir / "labels.nrrd").string() + "\n    wall_label: 2\n");
+  for (const char* c : {"sv", "img"}) {
+    SCOPED_TRACE(c);
+    auto r = run_stentsim("run " + (dir / (std::string(c) + ".yaml")).string() + " --until centerline");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const fs::path work = dir / (std::string(c) + ".work");
+    for (const char* f : {"segmentation/lumen.vtp", "segmentation/wall.vtp", "centerline/centerline.vtp"})
+      EXPECT_TRUE(fs::exists(work / f)) << f;
+    const auto cl = stentsim::read_vtp((work / "centerline/centerline.vtp").string());
+    ASSERT_GT(cl.points.size(), 10u);
+    // The label image's vessel runs along world x (index k), from x = 5.5 to 14.4 mm.
+    if (std::string(c) == "img")
+      for (const auto& p : cl.points) {
+        EXPECT_NEAR(p.y(), 6.0 + 1.95, 0.05);
+        EXPECT_NEAR(p.z(), 7.0 + 1.95, 0.05);
+      }
+  }
 }
 
 }  // namespace
