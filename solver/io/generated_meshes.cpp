@@ -87,7 +87,9 @@ MeshData hex8_to_tet4(const MeshData& hex) {
   return t;
 }
 
-MeshData tet4_to_tet10(const MeshData& tet) {
+namespace {
+
+MeshData tet4_to_tet10_with(const MeshData& tet, const auto& midpoint) {
   static const int kEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
   MeshData m;
   m.points = tet.points;
@@ -99,13 +101,30 @@ MeshData tet4_to_tet10(const MeshData& tet) {
       auto a = conn[static_cast<std::size_t>(e[0])], b = conn[static_cast<std::size_t>(e[1])];
       const auto key = std::minmax(a, b);
       auto [it, inserted] = mid.try_emplace({key.first, key.second}, static_cast<std::int64_t>(m.points.size()));
-      if (inserted) m.points.push_back(0.5 * (m.points[static_cast<std::size_t>(a)] + m.points[static_cast<std::size_t>(b)]));
+      if (inserted) m.points.push_back(midpoint(m.points[static_cast<std::size_t>(a)], m.points[static_cast<std::size_t>(b)]));
       conn.push_back(it->second);
     }
     m.add_cell(CellType::quadratic_tetra, conn);
   }
   m.cell_data = tet.cell_data;
   return m;
+}
+
+}  // namespace
+
+MeshData tet4_to_tet10(const MeshData& tet) {
+  return tet4_to_tet10_with(tet, [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return Eigen::Vector3d(0.5 * (a + b)); });
+}
+
+MeshData tet4_to_tet10_cylindrical(const MeshData& tet) {
+  return tet4_to_tet10_with(tet, [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    const double ra = std::hypot(a.x(), a.y()), rb = std::hypot(b.x(), b.y());
+    if (ra == 0 || rb == 0) return Eigen::Vector3d(0.5 * (a + b));  // on the axis: no angle
+    const double ta = std::atan2(a.y(), a.x());
+    const double dt = std::remainder(std::atan2(b.y(), b.x()) - ta, 2 * M_PI);  // the short way round
+    const double r = 0.5 * (ra + rb), t = ta + 0.5 * dt;
+    return Eigen::Vector3d(r * std::cos(t), r * std::sin(t), 0.5 * (a.z() + b.z()));
+  });
 }
 
 }  // namespace stentsim::solver

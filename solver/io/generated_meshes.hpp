@@ -21,4 +21,10 @@ MeshData hex8_to_tet4(const MeshData& hex);
 /// tet4 -> tet10 with shared straight-edge midpoints. Point arrays are dropped.
 MeshData tet4_to_tet10(const MeshData& tet);
 
+/// tet4 -> tet10 of a mesh of a ring about the z axis with each midside node
+/// at the edge's midpoint in (r, theta, z): the quadratic elements then follow
+/// the cylinders r = const exactly at their nodes (curved, isoparametric
+/// geometry), so the inner and outer faces of a ring sector are not chords.
+MeshData tet4_to_tet10_cylindrical(const MeshData& tet);
+
 }  // namespace stentsim::solver

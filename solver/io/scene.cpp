@@ -32,6 +32,10 @@ MeshData read_mesh(ConfigMap& m, std::string& source) {
   ConfigMap g = m.map("generate");
   const std::string type = g.choice("type", {"ring_sector", "box"});
   const std::string element = g.choice("element", {"hex8", "tet4", "tet10"}, "hex8");
+  // tet10 midside nodes: on straight edges, or (ring sector) on the exact cylinders.
+  const std::string midside = g.choice("midside", {"straight", "cylinder"}, "straight");
+  if (midside == "cylinder" && (type != "ring_sector" || element != "tet10"))
+    g.fail("midside", "'cylinder' places tet10 midside nodes on a ring sector's cylinders; needs type: ring_sector and element: tet10");
   MeshData mesh;
   if (type == "ring_sector") {
     const double ri = g.quantity("inner_radius", units::kLength, std::nullopt, Range::positive());
@@ -54,7 +58,7 @@ MeshData read_mesh(ConfigMap& m, std::string& source) {
   if (element != "hex8") {
     auto pd = mesh.point_data;
     mesh = hex8_to_tet4(mesh);
-    if (element == "tet10") mesh = tet4_to_tet10(mesh);
+    if (element == "tet10") mesh = midside == "cylinder" ? tet4_to_tet10_cylindrical(mesh) : tet4_to_tet10(mesh);
     else mesh.point_data = pd;
   }
   g.finish();

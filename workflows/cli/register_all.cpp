@@ -11,6 +11,7 @@ void register_segmentation(CLI::App& app);
 void register_device(CLI::App& app);
 void register_fibers(CLI::App& app);
 void register_mesh(CLI::App& app);
+void register_study(CLI::App& app);
 
 void register_all(CLI::App& app) {
   register_init(app);
@@ -21,6 +22,7 @@ void register_all(CLI::App& app) {
   register_mesh(app);
   register_fibers(app);
   register_solve(app);
+  register_study(app);
   register_version(app);
 }
 

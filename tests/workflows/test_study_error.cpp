@@ -1,0 +1,256 @@
+// Error study (issue 11): Richardson/GCI and fitted orders on synthetic data,
+// study-file validation, the analytic references of the shipped scenes, and
+// the runner on a cheap command (phantom segmentation, ~0.5 s a run):
+// caching, core limit, CSV columns, plots, --dry-run / --yes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "tests/workflows/cli_runner.hpp"
+#include "workflows/study/analytic_references.hpp"
+#include "workflows/study/convergence.hpp"
+#include "workflows/study/error_study.hpp"
+#include "workflows/study/study_config.hpp"
+
+namespace fs = std::filesystem;
+using namespace stentsim;
+using namespace stentsim::study;
+
+namespace {
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("stentsim_test_study_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write(const fs::path& f, const std::string& text) {
+  std::ofstream(f) << text;
+}
+
+std::string read(const fs::path& f) {
+  std::ifstream in(f);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A study over the phantom segmentation: the QoI true_min_radius does not
+// depend on the knob, which is all the runner tests need.
+fs::path phantom_study(const fs::path& dir, const std::string& values, const std::string& extra = "") {
+  write(dir / "phantom.yaml", "input:\n  phantom: {preset: straight-healthy, circumferential_points: 32}\n");
+  write(dir / "study.yaml", "name: seg\nbase: phantom.yaml\ncommands: [[segmentation, \"{input}\", --out, \"{run}\"]]\n"
+                            "qoi: true_min_radius\nreference: {type: value, value: 1.0}\ntolerance: 0.9\n"
+                            "knobs:\n  - name: points\n    key: input.phantom.circumferential_points\n    values: " +
+                                values + "\n" + extra);
+  return dir / "study.yaml";
+}
+
+}  // namespace
+
+TEST(StudyConvergence, RichardsonRecoversKnownOrderAndLimit) {
+  // f = 2 + 0.3 h^2 at h = 0.4, 0.2, 0.1 (ratio 2): p = 2, limit 2.
+  const std::vector<double> h{0.4, 0.2, 0.1};
+  std::vector<double> f;
+  for (double x : h) f.push_back(2 + 0.3 * x * x);
+  const Richardson r = richardson(h, f, 2.0);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_NEAR(r.observed_order, 2.0, 1e-10);
+  EXPECT_NEAR(r.extrapolated, 2.0, 1e-12);
+  EXPECT_NEAR(r.ratio, 2.0, 1e-12);
+  // GCI_fine = 1.25 |(f1 - f2)/f1| / (r^p - 1) (Roache).
+  const double f1 = f[2], f2 = f[1];
+  EXPECT_NEAR(r.gci_fine, 1.25 * std::abs((f1 - f2) / f1) / 3.0, 1e-14);
+  // Order 3 data against a theoretical order 1.5: 3 > 1.5 x 1.5, not asymptotic, no extrapolation.
+  std::vector<double> g;
+  for (double x : h) g.push_back(1 + x * x * x);
+  const Richardson nr = richardson(h, g, 1.5);
+  EXPECT_FALSE(nr.ok);
+  EXPECT_FALSE(nr.asymptotic);
+  EXPECT_NEAR(nr.observed_order, 3.0, 1e-10);
+  EXPECT_NE(nr.message.find("not asymptotic"), std::string::npos);
+}
+
+TEST(StudyConvergence, RichardsonRejectsBadRatiosAndOscillation) {
+  EXPECT_FALSE(richardson({0.12, 0.1, 0.0833333}, {1.1, 1.05, 1.02}, 2.0).ok);  // ratio 1.2 < 1.5
+  const Richardson uneven = richardson({0.4, 0.2, 0.05}, {1.2, 1.1, 1.0}, 2.0);
+  EXPECT_FALSE(uneven.ok);
+  EXPECT_NE(uneven.message.find("not constant"), std::string::npos);
+  EXPECT_FALSE(richardson({0.4, 0.2, 0.1}, {1.2, 0.9, 1.1}, 2.0).ok);  // oscillating
+}
+
+TEST(StudyConvergence, FittedAndPairwiseOrders) {
+  const std::vector<double> h{0.3, 0.15, 0.075};
+  std::vector<double> e;
+  for (double x : h) e.push_back(3 * std::pow(x, 1.5));
+  ASSERT_TRUE(fitted_order(h, e).has_value());
+  EXPECT_NEAR(*fitted_order(h, e), 1.5, 1e-12);
+  for (double p : pairwise_orders(h, e)) EXPECT_NEAR(p, 1.5, 1e-12);
+  EXPECT_FALSE(fitted_order({0.1}, {0.01}).has_value());
+}
+
+TEST(StudyConfigFile, ErrorsNameFileAndKey) {
+  const fs::path d = fresh_dir("config");
+  write(d / "phantom.yaml", "input:\n  phantom: {preset: straight-healthy}\n");
+  auto expect_error = [&](const std::string& text, const std::string& needle) {
+    write(d / "bad.yaml", text);
+    try {
+      load_study(d / "bad.yaml");
+      ADD_FAILURE() << "no error for: " << text;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("bad.yaml"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+    }
+  };
+  const std::string head = "base: phantom.yaml\nqoi: x\nreference: {type: value, value: 1}\n";
+  expect_error(head + "knobs: [{name: a, key: input.phantom.seed, values: [1]}]\nbogus: 1\n", "bogus");
+  expect_error(head + "knobs: [{name: a, key: input.nothing.seed, values: [1]}]\n", "input.nothing.seed");
+  expect_error(head + "knobs: [{name: a, key: input.phantom.seed, values: [1], h: [0.1, 0.2]}]\n", "h");
+  expect_error(head + "knobs: [{name: a, key: input.phantom.seed, values: [1]}]\ngrid: [a, b]\n", "grid");
+  expect_error("base: missing.yaml\nqoi: x\nreference: {type: value, value: 1}\nknobs: []\n", "base");
+  expect_error(head + "knobs: [{name: a, key: input.phantom.seed, values: [1], colour: red}]\n", "colour");
+  expect_error("base: phantom.yaml\nqoi: x\nreference: {type: richardson, knob: a}\n"
+               "knobs: [{name: a, key: input.phantom.seed, values: [1, 2]}]\n",
+               "Richardson");
+  fs::remove_all(d);
+}
+
+TEST(StudyReferences, ShippedScenesMatchClosedForms) {
+  const fs::path src(STENTSIM_TEST_SOURCE_DIR);
+  const fs::path d = fresh_dir("refs");
+  // Tube: the example's own value (0.12 MPa, E = 1, nu = 0.45): 1.176890 mm.
+  write(d / "tube.yaml", "base: " + (src / "examples/tube_inflation.yaml").string() +
+                             "\nqoi: inner_radius_at_pmax\nreference: {type: tube_plane_strain}\n"
+                             "knobs: [{name: n, key: bodies.0.mesh.generate.radial, values: [2]}]\n");
+  const StudyConfig tube = load_study(d / "tube.yaml");
+  EXPECT_NEAR(analytic_reference(tube, tube.base).at(0), 1.176890, 1e-6);
+  // Roll-up by 2 pi: the tip returns to the root and has turned by 2 pi.
+  write(d / "beam.yaml", "base: " + (src / "examples/beam_rollup.yaml").string() +
+                             "\nqoi: tip_position\nreference: {type: beam_rollup}\nerror: absolute\n"
+                             "knobs: [{name: n, key: bodies.0.beam.generate.elements, values: [8]}]\n");
+  StudyConfig beam = load_study(d / "beam.yaml");
+  const auto tip = analytic_reference(beam, beam.base);
+  ASSERT_EQ(tip.size(), 3u);
+  for (double x : tip) EXPECT_NEAR(x, 0.0, 1e-9);
+  beam.qoi = "tip_rotation_angle";
+  EXPECT_NEAR(analytic_reference(beam, beam.base).at(0), 2 * M_PI, 1e-9);
+  fs::remove_all(d);
+}
+
+TEST(StudyRunner, CachesRunsAndRerunsOnlyNewPoints) {
+  const fs::path d = fresh_dir("cache");
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out";
+  std::ostringstream log;
+  ErrorStudyResult first;
+  ASSERT_EQ(run_error_study(phantom_study(d, "[16, 24]"), o, log, &first), 0) << log.str();
+  EXPECT_EQ(first.stats.executed, 3);  // base (32) + 16 + 24
+  EXPECT_EQ(first.stats.cached, 0);
+  ErrorStudyResult second;
+  ASSERT_EQ(run_error_study(d / "study.yaml", o, log, &second), 0);
+  EXPECT_EQ(second.stats.executed, 0);
+  EXPECT_EQ(second.stats.cached, 3);
+  // A new knob value: only that point runs.
+  ErrorStudyResult third;
+  ASSERT_EQ(run_error_study(phantom_study(d, "[16, 24, 40]"), o, log, &third), 0);
+  EXPECT_EQ(third.stats.executed, 1);
+  EXPECT_EQ(third.stats.cached, 3);
+  // A row from another binary version is recomputed unless --reuse-timings.
+  const fs::path result = run_dir(o.out_dir, third.plan.runs.back()) / "result.yaml";
+  std::string text = read(result);
+  const auto pos = text.find("binary_version: ");
+  ASSERT_NE(pos, std::string::npos);
+  text.insert(pos + 16, "old-");
+  write(result, text);
+  o.reuse_timings = true;
+  ErrorStudyResult reused;
+  ASSERT_EQ(run_error_study(d / "study.yaml", o, log, &reused), 0);
+  EXPECT_EQ(reused.stats.executed, 0);
+  o.reuse_timings = false;
+  ErrorStudyResult redone;
+  ASSERT_EQ(run_error_study(d / "study.yaml", o, log, &redone), 0);
+  EXPECT_EQ(redone.stats.executed, 1);
+  fs::remove_all(d);
+}
+
+TEST(StudyRunner, NeverMoreRanksInFlightThanCores) {
+  const fs::path d = fresh_dir("cores");
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out1";
+  o.jobs = 4;
+  o.cores = 1;
+  std::ostringstream log;
+  ErrorStudyResult one;
+  ASSERT_EQ(run_error_study(phantom_study(d, "[16, 24, 40]"), o, log, &one), 0) << log.str();
+  EXPECT_EQ(one.stats.executed, 4);
+  EXPECT_EQ(one.stats.max_ranks_in_flight, 1);
+  o.cores = 2;
+  o.out_dir = d / "out2";
+  ErrorStudyResult two;
+  ASSERT_EQ(run_error_study(d / "study.yaml", o, log, &two), 0);
+  EXPECT_EQ(two.stats.max_ranks_in_flight, 2);  // two at once, never three
+  // A run needing more ranks than cores is refused before anything runs.
+  o.out_dir = d / "out3";
+  phantom_study(d, "[16]", "  - name: ranks\n    key: \"@ranks\"\n    values: [3]\n");
+  EXPECT_THROW(run_error_study(d / "study.yaml", o, log), InputError);
+  EXPECT_FALSE(fs::exists(d / "out3" / "runs"));
+  fs::remove_all(d);
+}
+
+TEST(StudyRunner, WritesCsvMarkdownAndPlots) {
+  const fs::path d = fresh_dir("report");
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out";
+  std::ostringstream log;
+  ErrorStudyResult r;
+  ASSERT_EQ(run_error_study(phantom_study(d, "[16, 24]", "    h: [0.4, 0.2]\n"), o, log, &r), 0) << log.str();
+  const std::string csv = read(o.out_dir / "study.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  for (const char* col : {"run", "label", "status", "points", "qoi", "value", "reference", "error", "wall_time_s", "cpu_time_s",
+                          "peak_memory_mb", "ranks", "host", "nproc", "load_average", "binary_version", "pareto", "qoi.true_min_radius"})
+    EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos) << col << " in " << header;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 runs
+  for (const auto& row : r.results) {
+    EXPECT_EQ(row.status, "ok");
+    EXPECT_GT(row.wall_s, 0);
+    EXPECT_GT(row.peak_memory_mb, 1);
+  }
+  for (double e : r.outcome.error) EXPECT_TRUE(std::isfinite(e) && e > 0);
+  EXPECT_FALSE(r.outcome.pareto.empty());
+  ASSERT_TRUE(r.outcome.cheapest.has_value());  // tolerance 0.9 on a relative error < 1
+  for (const char* f : {"error_vs_wall_time.png", "error_vs_wall_time.svg", "error_vs_h.png", "error_vs_h.svg", "study.md"}) {
+    ASSERT_TRUE(fs::exists(o.out_dir / f)) << f;
+    EXPECT_GT(fs::file_size(o.out_dir / f), 1000u) << f;
+  }
+  const std::string md = read(o.out_dir / "study.md");
+  EXPECT_NE(md.find("Cheapest within tolerance"), std::string::npos);
+  EXPECT_NE(md.find("Pareto front"), std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST(StudyCli, DryRunListsRunsAndManyRunsNeedYes) {
+  const fs::path d = fresh_dir("cli");
+  std::string many = "[";
+  for (int i = 0; i < 60; ++i) many += (i ? ", " : "") + std::to_string(100 + i);
+  phantom_study(d, many + "]");
+  const auto dry = stentsim::testing::run_stentsim("study error " + (d / "study.yaml").string() + " --dry-run --out " + (d / "out").string());
+  EXPECT_EQ(dry.code, 0) << dry.out;
+  EXPECT_NE(dry.out.find("61 runs"), std::string::npos) << dry.out;
+  EXPECT_NE(dry.out.find("--yes"), std::string::npos) << dry.out;
+  const auto refused = stentsim::testing::run_stentsim("study error " + (d / "study.yaml").string() + " --out " + (d / "out").string());
+  EXPECT_EQ(refused.code, 2) << refused.out;
+  EXPECT_NE(refused.out.find("--yes"), std::string::npos) << refused.out;
+  EXPECT_FALSE(fs::exists(d / "out" / "runs"));
+  const auto bad = stentsim::testing::run_stentsim("study error " + (d / "nothing.yaml").string());
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  fs::remove_all(d);
+}

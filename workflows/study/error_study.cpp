@@ -1,0 +1,105 @@
+#include "workflows/study/error_study.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <ostream>
+
+#include "common/error.hpp"
+#include "workflows/study/study_config.hpp"
+
+namespace fs = std::filesystem;
+
+namespace stentsim::study {
+
+double estimate_seconds(const StudyConfig& s, const StudyPlan& plan, std::size_t run,
+                        const std::vector<std::optional<double>>& measured) {
+  if (measured[run]) return *measured[run];
+  int best_diff = std::numeric_limits<int>::max();
+  double best = -1;
+  const auto& a = plan.runs[run].setting;
+  for (std::size_t j = 0; j < plan.runs.size(); ++j) {
+    if (!measured[j]) continue;
+    const auto& b = plan.runs[j].setting;
+    int diff = 0;
+    double scale = 1;
+    for (const auto& k : s.knobs) {
+      auto ia = a.find(k.name), ib = b.find(k.name);
+      const int va = ia == a.end() ? -1 : ia->second, vb = ib == b.end() ? -1 : ib->second;
+      if (va == vb) continue;
+      ++diff;
+      if (k.cost_exponent > 0 && va >= 0 && vb >= 0)
+        scale *= std::pow(k.h[static_cast<std::size_t>(vb)] / k.h[static_cast<std::size_t>(va)], k.cost_exponent);
+    }
+    if (diff < best_diff) {
+      best_diff = diff;
+      best = *measured[j] * scale;
+    }
+  }
+  return best;
+}
+
+int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostream& out, ErrorStudyResult* result) {
+  const StudyConfig study = load_study(file);
+  ErrorStudyResult local;
+  ErrorStudyResult& r = result ? *result : local;
+  r.out_dir = o.out_dir.empty() ? file.parent_path() / (study.name + ".study") : o.out_dir;
+  r.plan = plan_study(study);
+  const std::size_t n = r.plan.runs.size();
+  const HostInfo host = this_host(o.binary);
+
+  std::vector<std::optional<double>> measured(n);
+  std::size_t cached = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const fs::path dir = run_dir(r.out_dir, r.plan.runs[i]);
+    if (auto c = cached_result(dir, host, o.reuse_timings)) {
+      measured[i] = c->wall_s;
+      ++cached;
+    } else if (auto any = cached_result(dir, host, true)) {
+      measured[i] = any->wall_s;  // another host or binary: a fair estimate, still re-run
+    }
+  }
+  if (o.dry_run) {
+    out << fmt::format("study {}: {} runs ({} cached, {} to run) in {}\n", study.name, n, cached, n - cached, r.out_dir.string());
+    double total = 0;
+    bool unknown = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool is_cached = cached_result(run_dir(r.out_dir, r.plan.runs[i]), host, o.reuse_timings).has_value();
+      const double est = estimate_seconds(study, r.plan, i, measured);
+      if (!is_cached) {
+        if (est >= 0) total += est;
+        else unknown = true;
+      }
+      out << fmt::format("  {} {:<50} ranks {}  {}\n", r.plan.runs[i].key.substr(0, 8), r.plan.runs[i].label, r.plan.runs[i].ranks,
+                         is_cached ? "cached" : est >= 0 ? fmt::format("~{:.1f} s", est) : "unknown (nothing measured yet)");
+    }
+    out << fmt::format("estimated time to run: {:.0f} s{}\n", total, unknown ? " + runs without an estimate" : "");
+    if (n > kMaxRunsWithoutYes) out << fmt::format("more than {} runs: the real run needs --yes\n", kMaxRunsWithoutYes);
+    return 0;
+  }
+  if (n - cached > kMaxRunsWithoutYes && !o.yes)
+    throw InputError(fmt::format("{}: the study has {} runs to do (more than {}); check it with --dry-run and confirm with --yes",
+                                 file.string(), n - cached, kMaxRunsWithoutYes));
+  out << fmt::format("study {}: {} runs ({} cached) in {}\n", study.name, n, cached, r.out_dir.string()) << std::flush;
+  ExecOptions eo;
+  eo.binary = o.binary;
+  eo.jobs = o.jobs;
+  eo.cores = o.cores;
+  eo.reuse_timings = o.reuse_timings;
+  eo.out = &out;
+  r.stats = execute_runs(study, r.plan, r.out_dir, eo, r.results);
+  r.outcome = evaluate_study(study, r.plan, r.results);
+  r.files = write_report(study, r.plan, r.results, r.outcome, r.out_dir);
+  out << fmt::format("{} runs executed, {} cached, {} failed; reference: {}\n", r.stats.executed, r.stats.cached, r.stats.failed,
+                     r.outcome.reference_note);
+  for (const auto& l : r.outcome.lines)
+    if (l.fitted_order) out << fmt::format("  order along {}: fitted {:.3f}\n", l.label, *l.fitted_order);
+  if (r.outcome.cheapest)
+    out << fmt::format("cheapest within tolerance {:.3g}: {} ({:.3g} s)\n", *study.tolerance, r.plan.runs[*r.outcome.cheapest].label,
+                       r.results[*r.outcome.cheapest].wall_s);
+  out << fmt::format("wrote {} and {}\n", r.files.csv.string(), r.files.markdown.string());
+  return r.stats.failed > 0 ? 1 : 0;
+}
+
+}  // namespace stentsim::study

@@ -1,0 +1,46 @@
+#pragma once
+// `stentsim study error STUDY.yaml`: plan, (dry-run estimate,) run what is not
+// cached, evaluate and report (study.csv, study.md, plots).
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include "workflows/study/run_executor.hpp"
+#include "workflows/study/study_report.hpp"
+
+namespace stentsim::study {
+
+struct ErrorStudyOptions {
+  std::filesystem::path out_dir;  ///< empty: <study file's folder>/<name>.study
+  bool dry_run = false;
+  bool yes = false;               ///< allow more than kMaxRunsWithoutYes runs
+  bool reuse_timings = false;
+  int jobs = 1;
+  int cores = 0;                  ///< 0: the machine's
+  std::string binary;             ///< the stentsim executable
+};
+
+inline constexpr std::size_t kMaxRunsWithoutYes = 50;
+
+struct ErrorStudyResult {
+  StudyPlan plan;
+  std::vector<RunResult> results;
+  StudyOutcome outcome;
+  ReportFiles files;
+  ExecStats stats;
+  std::filesystem::path out_dir;
+};
+
+/// Runs the study; prints progress and a summary to `out`. Returns the exit
+/// code: 0 when every run succeeded, 1 when some failed (they are in the table).
+/// A dry run only prints the runs with estimated times (result has no files).
+int run_error_study(const std::filesystem::path& study_file, const ErrorStudyOptions& options, std::ostream& out,
+                    ErrorStudyResult* result = nullptr);
+
+/// Estimated seconds of a run from measured rows in the study's cache: its
+/// own, else the nearest measured run (fewest knobs differing) scaled by the
+/// refinement knobs' cost exponents; negative when nothing was measured yet.
+double estimate_seconds(const StudyConfig& study, const StudyPlan& plan, std::size_t run,
+                        const std::vector<std::optional<double>>& measured);
+
+}  // namespace stentsim::study

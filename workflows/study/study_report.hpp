@@ -1,0 +1,50 @@
+#pragma once
+// What an error study reports: each run's error against the reference, the
+// order along each refinement line (fitted, pairwise, Richardson + GCI), the
+// Pareto front of error against wall time and the cheapest run within the
+// tolerance; written as study.csv, study.md and PNG/SVG plots.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "workflows/study/convergence.hpp"
+#include "workflows/study/run_executor.hpp"
+#include "workflows/study/study_config.hpp"
+#include "workflows/study/study_runs.hpp"
+
+namespace stentsim::study {
+
+struct LineSummary {
+  std::string label, knob;
+  std::vector<std::size_t> runs;   ///< runs with a value, in the knob's order
+  std::vector<double> h, error, value;
+  std::optional<double> fitted_order;
+  std::vector<double> pairwise_orders;
+  std::optional<Richardson> richardson;  ///< from the QoI values alone (three finest)
+};
+
+struct StudyOutcome {
+  std::vector<double> value;       ///< scalar QoI per run (norm for vectors); NaN when missing
+  std::vector<std::vector<double>> reference;  ///< per run (empty when none)
+  std::vector<double> error;       ///< NaN when unknown
+  std::vector<LineSummary> lines;
+  std::vector<std::size_t> pareto; ///< runs on the front, by increasing wall time
+  std::optional<std::size_t> cheapest;  ///< cheapest run with error <= tolerance
+  std::string reference_note;      ///< how the reference was obtained
+};
+
+/// Errors, orders, front. Throws InputError for a study whose reference does
+/// not fit its QoI (e.g. a relative error against a zero reference).
+StudyOutcome evaluate_study(const StudyConfig& study, const StudyPlan& plan, const std::vector<RunResult>& results);
+
+/// Files written into `out_dir`.
+struct ReportFiles {
+  std::filesystem::path csv, markdown;
+  std::vector<std::filesystem::path> plots;
+};
+
+ReportFiles write_report(const StudyConfig& study, const StudyPlan& plan, const std::vector<RunResult>& results,
+                         const StudyOutcome& outcome, const std::filesystem::path& out_dir);
+
+}  // namespace stentsim::study
