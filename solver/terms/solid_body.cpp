@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "common/error.hpp"
+#include "solver/assembly/parallel.hpp"
 #include "solver/terms/element_failure.hpp"
 #include "solver/terms/solid_kernel.hpp"
 
@@ -110,6 +111,7 @@ void SolidBody::assemble_element(const Element& el, const SystemState& state, As
 }
 
 void SolidBody::assemble(const SystemState& state, Assembler& out) {
+  rank_ = state.rank, ranks_ = state.ranks;
   const bool tangent = out.wants_tangent();
   const std::size_t n = elements_.size();
   for (std::size_t e = 0; e < n; ++e) {
@@ -122,6 +124,47 @@ void SolidBody::assemble(const SystemState& state, Assembler& out) {
       default: break;
     }
   }
+}
+
+void SolidBody::commit() {
+  if (ranks_ > 1 && !committed_.empty()) {
+    // Owned slots carry this rank's trial history, the others zero; the sum over ranks is the whole history.
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(12 * static_cast<Eigen::Index>(trial_.size()));
+    const Eigen::VectorXd none;
+    SystemState owner{none, 0.0, 0.0, rank_, ranks_};
+    for (std::size_t e = 0; e < elements_.size(); ++e) {
+      const Element& el = elements_[e];
+      if (el.history < 0 || !owner.owns(e, elements_.size())) continue;
+      for (int q = 0; q < points_of(mesh_.cell_types[el.cell]); ++q) {
+        const auto slot = static_cast<Eigen::Index>(el.history + q);
+        v.segment<6>(12 * slot) = trial_[static_cast<std::size_t>(slot)].q;
+        v.segment<6>(12 * slot + 6) = trial_[static_cast<std::size_t>(slot)].s_inf;
+      }
+    }
+    parallel::sum(v);
+    for (std::size_t k = 0; k < trial_.size(); ++k)
+      trial_[k] = {v.segment<6>(12 * static_cast<Eigen::Index>(k)), v.segment<6>(12 * static_cast<Eigen::Index>(k) + 6)};
+  }
+  committed_ = trial_;
+}
+
+void SolidBody::save_history(HistoryArchive& out, const std::string& prefix) const {
+  std::vector<double> v;
+  v.reserve(12 * committed_.size());
+  for (const auto& h : committed_) {
+    v.insert(v.end(), h.q.data(), h.q.data() + 6);
+    v.insert(v.end(), h.s_inf.data(), h.s_inf.data() + 6);
+  }
+  out.put(prefix + "viscous_q_s_inf", v);
+}
+
+void SolidBody::load_history(const HistoryArchive& in, const std::string& prefix) {
+  const auto& v = in.get(prefix + "viscous_q_s_inf", 12 * static_cast<long long>(committed_.size()));
+  for (std::size_t k = 0; k < committed_.size(); ++k) {
+    committed_[k].q = Eigen::Map<const Vec6>(&v[12 * k]);
+    committed_[k].s_inf = Eigen::Map<const Vec6>(&v[12 * k + 6]);
+  }
+  trial_ = committed_;
 }
 
 template <class E>

@@ -37,8 +37,15 @@ class SolidBody : public Term {
 
   std::string name() const override { return name_; }
   void assemble(const SystemState& state, Assembler& out) override;
-  void commit() override { committed_ = trial_; }
+  /// With MPI, each rank updated the viscous history of its own elements only:
+  /// commit sums the owned slots over ranks so that every rank holds all of it
+  /// (stress output and checkpoints are written by rank 0).
+  void commit() override;
   void rollback() override { trial_ = committed_; }
+  /// Viscous history per quadrature point (Q, S_inf; 12 numbers per slot) for restart.
+  bool has_history() const override { return !committed_.empty(); }
+  void save_history(HistoryArchive& out, const std::string& prefix) const override;
+  void load_history(const HistoryArchive& in, const std::string& prefix) override;
 
   std::size_t num_nodes() const { return mesh_.points.size(); }
   GlobalDof num_dofs() const { return 3 * static_cast<GlobalDof>(num_nodes()); }
@@ -75,6 +82,7 @@ class SolidBody : public Term {
   std::vector<Element> elements_;
   GlobalDof first_dof_;
   std::vector<ViscousHistory> committed_, trial_;
+  int rank_ = 0, ranks_ = 1;  // element partition of the last assembly
 };
 
 }  // namespace stentsim::solver
