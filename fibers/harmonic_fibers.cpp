@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "common/error.hpp"
@@ -138,6 +139,72 @@ std::vector<Vec3> cell_gradients(const MeshData& mesh, const Eigen::VectorXd& u)
   return out;
 }
 
+/// The tet4 mesh on the corner nodes of the tet10 cells (other volume cells
+/// copied), with its points numbered compactly (`full` maps back), and each
+/// midside node with its edge's two corners, for the linear Laplace solves.
+struct CornerMesh {
+  MeshData mesh;
+  std::vector<std::int64_t> full;                    // corner-mesh point -> mesh point
+  std::vector<std::array<std::int64_t, 3>> midside;  // mesh node, corner a, corner b (mesh numbering)
+};
+
+CornerMesh corner_mesh(const MeshData& m) {
+  CornerMesh out;
+  static constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};  // VTK tet10 midside order
+  std::vector<std::int64_t> index(m.points.size(), -1);
+  std::vector<char> seen(m.points.size(), 0);
+  auto corner = [&](std::int64_t p) {
+    auto& i = index[static_cast<std::size_t>(p)];
+    if (i < 0) {
+      i = static_cast<std::int64_t>(out.full.size());
+      out.full.push_back(p);
+      out.mesh.points.push_back(m.points[static_cast<std::size_t>(p)]);
+    }
+    return i;
+  };
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    if (!is_volume_cell(m.cell_types[c])) continue;
+    const auto n = m.cell(c);
+    if (m.cell_types[c] != CellType::quadratic_tetra) {
+      std::vector<std::int64_t> k;
+      for (auto p : n) k.push_back(corner(p));
+      out.mesh.add_cell(m.cell_types[c], k);
+      continue;
+    }
+    out.mesh.add_cell(CellType::tetra, {corner(n[0]), corner(n[1]), corner(n[2]), corner(n[3])});
+    for (int e = 0; e < 6; ++e) {
+      const auto k = static_cast<std::size_t>(n[static_cast<std::size_t>(4 + e)]);
+      if (seen[k]) continue;
+      seen[k] = 1;
+      out.midside.push_back({n[static_cast<std::size_t>(4 + e)], n[static_cast<std::size_t>(kEdge[e][0])],
+                             n[static_cast<std::size_t>(kEdge[e][1])]});
+    }
+  }
+  return out;
+}
+
+/// Solves one Laplace problem, on the corner mesh when given: Dirichlet values
+/// on midside nodes are dropped there (their corners carry the same value) and
+/// the solution is interpolated linearly along the edges afterwards (exact for
+/// the piecewise-linear field on straight edges). Returns u on `mesh` points.
+LaplaceSolve solve_on(const MeshData& mesh, const CornerMesh* corners, const std::map<std::int64_t, double>& d,
+                      const std::string& solver) {
+  if (!corners) return solve_laplace(mesh, d, solver);
+  std::vector<std::int64_t> index(mesh.points.size(), -1);
+  for (std::size_t i = 0; i < corners->full.size(); ++i) index[static_cast<std::size_t>(corners->full[i])] = static_cast<std::int64_t>(i);
+  std::map<std::int64_t, double> dc;
+  for (const auto& [node, value] : d)
+    if (index[static_cast<std::size_t>(node)] >= 0) dc[index[static_cast<std::size_t>(node)]] = value;
+  LaplaceSolve r = solve_laplace(corners->mesh, dc, solver);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.points.size()));
+  for (std::size_t i = 0; i < corners->full.size(); ++i) u(corners->full[i]) = r.u(static_cast<Eigen::Index>(i));
+  for (const auto& [node, a, b] : corners->midside) u(node) = 0.5 * (u(a) + u(b));
+  // A midside node on a tagged face has both corners on it: its value is the boundary value.
+  for (const auto& [node, value] : d) u(node) = value;
+  r.u = std::move(u);
+  return r;
+}
+
 }  // namespace
 
 FiberQuality fiber_quality(const MeshData& f) {
@@ -210,10 +277,15 @@ HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& center
 
   HarmonicFiberResult res;
   const auto t0 = std::chrono::steady_clock::now();
-  const LaplaceSolve t = solve_laplace(mesh, dirichlet(groups.at(tags::endothelium), groups.at(tags::outer_wall), "transmural", source),
-                                       o.linear_solver);
-  const LaplaceSolve l = solve_laplace(mesh, dirichlet(groups.at(tags::proximal_cut), groups.at(tags::distal_cut), "longitudinal", source),
-                                       o.linear_solver);
+  bool quadratic = false;
+  for (auto t : mesh.cell_types) quadratic = quadratic || t == CellType::quadratic_tetra;
+  std::optional<CornerMesh> corners;
+  if (quadratic && o.linear_on_corners) corners = corner_mesh(mesh);
+  const CornerMesh* cm = corners ? &*corners : nullptr;
+  const LaplaceSolve t = solve_on(mesh, cm, dirichlet(groups.at(tags::endothelium), groups.at(tags::outer_wall), "transmural", source),
+                                  o.linear_solver);
+  const LaplaceSolve l = solve_on(mesh, cm, dirichlet(groups.at(tags::proximal_cut), groups.at(tags::distal_cut), "longitudinal", source),
+                                  o.linear_solver);
   res.laplace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   res.transmural_residual = t.relative_residual;
   res.longitudinal_residual = l.relative_residual;
@@ -227,7 +299,18 @@ HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& center
   std::vector<CellFrame> frames;
   frames.reserve(volume_cells);
   double orientation = 0;  // sum of tangent . grad l: the centerline may run distal -> proximal
-  const std::vector<Vec3> grad_t = cell_gradients(mesh, t.u), grad_l = cell_gradients(mesh, l.u);
+  // On the corner mesh the fields are linear per tet: recovered gradients as
+  // for tet4 (corner-mesh cells are the volume cells in the same order).
+  std::vector<Vec3> grad_t, grad_l;
+  if (cm) {
+    Eigen::VectorXd tc(static_cast<Eigen::Index>(cm->full.size())), lc(tc.size());
+    for (std::size_t i = 0; i < cm->full.size(); ++i) tc(static_cast<Eigen::Index>(i)) = t.u(cm->full[i]), lc(static_cast<Eigen::Index>(i)) = l.u(cm->full[i]);
+    grad_t = cell_gradients(cm->mesh, tc);
+    grad_l = cell_gradients(cm->mesh, lc);
+  } else {
+    grad_t = cell_gradients(mesh, t.u);
+    grad_l = cell_gradients(mesh, l.u);
+  }
   for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
     if (!is_volume_cell(mesh.cell_types[c])) continue;
     const Vec3 gt = grad_t[frames.size()], gl = grad_l[frames.size()];
@@ -284,7 +367,8 @@ HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& center
   out.cell_data["LongitudinalCoordinate"] = std::move(lc);
   out.point_data["Transmural"] = {1, std::vector<double>(t.u.data(), t.u.data() + t.u.size())};
   out.point_data["LongitudinalCoordinate"] = {1, std::vector<double>(l.u.data(), l.u.data() + l.u.size())};
-  out.field_text["method"] = fmt::format("harmonic lifting (centerline weight {})", o.centerline_weight);
+  out.field_text["method"] = fmt::format("harmonic lifting (centerline weight {}{})", o.centerline_weight,
+                                         cm ? ", linear Laplace solves on the tet10 corner nodes" : "");
   res.quality = fiber_quality(out);
   res.quality.tangent_blend_angle_max_deg = blend_max;
   return res;
@@ -309,8 +393,8 @@ void write_harmonic_fibers(const std::string& artery_vtu, const std::string& cen
   summary.set("tangent_vs_grad_l_angle_max", q.tangent_blend_angle_max_deg, "deg");
   summary.set("laplace_relative_residual", std::max(r.transmural_residual, r.longitudinal_residual));
   summary.set("laplace_time", r.laplace_seconds, "s");
-  summary.note("fiber_method", fmt::format("harmonic lifting, centerline weight {}, linear solver {}", o.centerline_weight,
-                                           o.linear_solver));
+  summary.note("fiber_method", fmt::format("harmonic lifting, centerline weight {}, linear solver {}{}", o.centerline_weight,
+                                           o.linear_solver, o.linear_on_corners ? ", tet10: linear solves on the corner nodes" : ""));
 }
 
 }  // namespace stentsim::fibers

@@ -21,7 +21,19 @@ struct HarmonicFiberOptions {
   /// Weight of the centerline tangent against grad l in the longitudinal
   /// direction (1: tangent only, 0: grad l only). Ours (the paper is silent).
   double centerline_weight = 0.5;
-  std::string linear_solver = "gmres_ilu";  // solver/linalg type
+  /// solver/linalg type (gmres_ilu: ILU(1); gmres_amg: scalar SA-AMG; direct).
+  /// On the case2-rca tet10 wall (452,165 nodes, 61k corner nodes) with the
+  /// corner solves: gmres_ilu 15 + 90 iterations, gmres_amg 61 + 52 and slower
+  /// (bench_fibers); the full tet10 problem did not finish in 8 min with either.
+  std::string linear_solver = "gmres_ilu";
+  /// tet10 meshes: solve the two Laplace problems with linear elements on the
+  /// tet10 corner nodes (the tet4 mesh of the same vertices) and interpolate
+  /// linearly to the midside nodes; the frames then use the recovered nodal
+  /// gradients like a tet4 mesh. About 7x fewer unknowns and far fewer matrix
+  /// entries than the quadratic problem; on gmsh tubes its accuracy against
+  /// the analytic fibers is the tet4 one (tests/fibers/test_gmsh_tube_fibers).
+  /// false: the full quadratic (tet10) problem.
+  bool linear_on_corners = true;
 };
 
 /// Figures of merit of a fiber field (recorded in summary.yaml).

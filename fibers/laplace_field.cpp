@@ -108,6 +108,7 @@ LaplaceSolve solve_laplace(const MeshData& mesh, const std::map<std::int64_t, do
   ls.tolerance = 1e-10;
   ls.max_iterations = 5000;
   ls.ilu_fill = 1;  // a scalar Laplace problem: ILU(1) converges in few iterations and sets up fast (ILU(4) does not pay off)
+  ls.amg_equations_per_node = 1;  // gmres_amg: scalar unknowns, constant near-null space
   auto linear = solver::make_linear_solver(ls);
   LaplaceSolve out;
   out.u = Eigen::VectorXd::Zero(n);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -175,9 +176,33 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
   return w;
 }
 
+namespace {
+
+/// Columns dx/dxi_k of the tet10 map at reference point (xi, eta, zeta); VTK
+/// node order (corners 0-3, midside nodes of edges 01, 12, 02, 03, 13, 23).
+/// Shape functions in barycentrics L: corners L_i (2 L_i - 1), edges 4 L_i L_j.
+Eigen::Matrix3d tet10_jacobian(const std::array<Vector3d, 10>& x, const std::array<double, 3>& xi) {
+  const double L[4] = {1 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]};
+  static const int edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+  Eigen::Matrix3d j = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    auto dL = [k](int i) { return i == 0 ? -1.0 : (i == k + 1 ? 1.0 : 0.0); };
+    for (int i = 0; i < 4; ++i) j.col(k) += (4 * L[i] - 1) * dL(i) * x[std::size_t(i)];
+    for (int e = 0; e < 6; ++e) {
+      const int a = edge[e][0], b = edge[e][1];
+      j.col(k) += 4 * (L[a] * dL(b) + L[b] * dL(a)) * x[std::size_t(4 + e)];
+    }
+  }
+  return j;
+}
+
+}  // namespace
+
 MeshQuality mesh_quality(const MeshData& m) {
   MeshQuality q;
   const auto& layer = m.cell_data.at(tags::kLayer);
+  double edge_sum = 0;
+  std::size_t edge_count = 0;
   for (std::size_t c = 0; c < m.num_cells(); ++c) {
     if (m.cell_types[c] != CellType::tetra && m.cell_types[c] != CellType::quadratic_tetra) continue;
     const auto nd = m.cell(c);
@@ -192,11 +217,33 @@ MeshQuality mesh_quality(const MeshData& m) {
       sj = std::min(sj, std::sqrt(2.0) * e1.dot(e2.cross(e3)) / (e1.norm() * e2.norm() * e3.norm()));
     }
     const double vol = (x[1] - x[0]).dot((x[2] - x[0]).cross(x[3] - x[0])) / 6;
+    if (m.cell_types[c] == CellType::quadratic_tetra) {
+      // The quadratic map at the corners and the 4-point rule's points
+      // (a = 0.1381966, b = 0.5854102): the scaled Jacobian of its columns
+      // (sqrt 2 det J / |J1||J2||J3|, the corner formula at corner 0 for a
+      // straight tet) and det J against the straight tet's 6 V.
+      std::array<Vector3d, 10> xq;
+      for (std::size_t a = 0; a < 10; ++a) xq[a] = m.points[std::size_t(nd[a])];
+      const double qa = 0.1381966011250105, qb = 0.5854101966249685;
+      const std::array<std::array<double, 3>, 8> at = {
+          {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {qa, qa, qa}, {qb, qa, qa}, {qa, qb, qa}, {qa, qa, qb}}};
+      for (const auto& xi : at) {
+        const Eigen::Matrix3d j = tet10_jacobian(xq, xi);
+        const double d = j.determinant();
+        sj = std::min(sj, std::sqrt(2.0) * d / (j.col(0).norm() * j.col(1).norm() * j.col(2).norm()));
+        q.min_jacobian_ratio = std::min(q.min_jacobian_ratio, d / (6 * vol));
+      }
+    }
     double area = 0, hmax = 0;
     static const int f[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
     for (auto& ff : f) area += 0.5 * (x[ff[1]] - x[ff[0]]).cross(x[ff[2]] - x[ff[0]]).norm();
     for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) hmax = std::max(hmax, (x[i] - x[j]).norm());
+      for (int j = i + 1; j < 4; ++j) {
+        const double h = (x[i] - x[j]).norm();
+        hmax = std::max(hmax, h);
+        edge_sum += h;
+        ++edge_count;
+      }
     const double rin = 3 * std::abs(vol) / area;
     const double ar = hmax / (2 * std::sqrt(6.0) * rin);
     const int L = int(layer.at(c));
@@ -209,6 +256,7 @@ MeshQuality mesh_quality(const MeshData& m) {
       q.worst_sj_cell = c;
     }
   }
+  q.mean_edge_length = edge_count ? edge_sum / double(edge_count) : 0.0;
   return q;
 }
 
@@ -241,13 +289,15 @@ void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesys
   for (int L : w.layers) summary.set(fmt::format("{}_elements", tags::layer_name(L)), double(q.elements_per_layer[std::size_t(L)]));
   summary.set("min_scaled_jacobian", q.min_scaled_jacobian);
   summary.set("max_aspect_ratio", q.max_aspect_ratio);
+  if (o.element == "tet10") summary.set("min_jacobian_ratio", q.min_jacobian_ratio);
+  summary.set("mean_edge_length", q.mean_edge_length, "mm");
   summary.set("sections", double(w.origin.size()));
   summary.set("thinned_layer_ray_fraction", w.clamped_fraction);
   summary.set("meshing_time", secs, "s");
   summary.note("element", o.element);
   summary.note("mesh_size_mm", fmt::format("{}", o.size));
-  log::info("mesh: {} {} elements, {} nodes, min scaled Jacobian {:.3f}, max aspect ratio {:.2f}, {:.1f} s", tets,
-            o.element, m.points.size(), q.min_scaled_jacobian, q.max_aspect_ratio, secs);
+  log::info("mesh: {} {} elements, {} nodes, mean edge {:.3f} mm, min scaled Jacobian {:.3f}, max aspect ratio {:.2f}, {:.1f} s",
+            tets, o.element, m.points.size(), q.mean_edge_length, q.min_scaled_jacobian, q.max_aspect_ratio, secs);
   if (q.min_scaled_jacobian < o.min_scaled_jacobian || q.max_aspect_ratio > o.max_aspect_ratio) std::filesystem::remove(msh_tmp);
   if (q.min_scaled_jacobian < o.min_scaled_jacobian)
     throw ComputeError(fmt::format(

@@ -75,6 +75,9 @@ FiberSettings parse_fibers(ConfigMap m) {
   s.intima_angle = m.quantity("intima_angle", units::kAngle, s.intima_angle, angle);
   s.adventitia_angle = m.quantity("adventitia_angle", units::kAngle, s.adventitia_angle, angle);
   s.tension_only = m.boolean("tension_only", s.tension_only);
+  s.centerline_weight = m.number("centerline_weight", s.centerline_weight, Range::between(0, 1));
+  s.linear_solver = m.choice("linear_solver", {"gmres_ilu", "gmres_amg", "direct"}, s.linear_solver);
+  s.laplace_on_corners = m.boolean("laplace_on_corners", s.laplace_on_corners);
   m.finish();
   return s;
 }

@@ -47,7 +47,7 @@ Stage patient_mesh_stage(const CaseConfig& c) {
   s.inputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp", "centerline/centerline.vtp"};
   s.outputs = {"mesh/artery.vtu", "mesh/artery.msh"};
   s.config = slice(c, {"mesh"});
-  s.version = "1";
+  s.version = "2";  // 2: per-layer sizing, tet10 midside-node Jacobian check
   const meshing::PatientMeshOptions o = c.mesh;
   s.run = [o](StageContext& ctx) {
     meshing::run_patient_mesh(ctx.input("segmentation/lumen.vtp"), ctx.input("segmentation/wall.vtp"),
@@ -81,10 +81,13 @@ Stage harmonic_fibers_stage(const CaseConfig& c) {
   s.inputs = {"mesh/artery.vtu", "centerline/centerline.vtp"};
   s.outputs = {"fibers/fibers.vtu"};
   s.config = slice(c, {"fibers"});
-  s.version = "1";
+  s.version = "2";  // 2: tet10 Laplace solves on the corner nodes; centerline_weight, linear_solver, laplace_on_corners keys
   fibers::HarmonicFiberOptions o;
   o.angles = {{tags::intima, c.fibers.intima_angle}, {tags::media, c.fibers.media_angle},
               {tags::adventitia, c.fibers.adventitia_angle}};
+  o.centerline_weight = c.fibers.centerline_weight;
+  o.linear_solver = c.fibers.linear_solver;
+  o.linear_on_corners = c.fibers.laplace_on_corners;
   s.run = [o](StageContext& ctx) {
     fibers::write_harmonic_fibers(ctx.input("mesh/artery.vtu").string(), ctx.input("centerline/centerline.vtp").string(), o,
                                   ctx.output("fibers/fibers.vtu").string(), ctx.summary());

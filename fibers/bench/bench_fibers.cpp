@@ -2,7 +2,10 @@
 // tube of about the size of the paper's Case 2 wall (238,123 nodes), the two
 // Laplace solves and the frame construction, median of several runs per
 // linear solver. Usage: bench_fibers [runs=3] [elements_around=96] [elements_along=63] [solvers=gmres_ilu]
-// (solvers: comma-separated solver/linalg types; "direct" KLU2 takes minutes at this size).
+// or, on a meshed patient wall: bench_fibers artery.vtu centerline.vtp [runs=3] [solvers=gmres_ilu]
+// (solvers: comma-separated solver/linalg types; "direct" KLU2 takes minutes at
+// this size; on the full quadratic problem of the case2-rca tet10 wall gmres_ilu
+// did not finish in 8 minutes: the fibers now solve on the corner nodes).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -18,20 +21,22 @@ using namespace stentsim;
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  const int runs = argc > 1 ? std::atoi(argv[1]) : 3;
+  const bool files = argc > 2 && std::string(argv[1]).size() > 4 && std::string(argv[1]).substr(std::string(argv[1]).size() - 4) == ".vtu";
+  const int shift = files ? 1 : 0;  // patient mode: runs is argument 3 (not 1)
+  const int runs = argc > 1 + 2 * shift ? std::atoi(argv[1 + 2 * shift]) : 3;
   fibers::TaggedTubeSpec s;
   s.inner_radius = 0.95, s.outer_radius = 1.55, s.length = 21.0;  // Case 2: 21 mm segment
   s.elements_radial = 4;
   s.elements_around = argc > 2 ? std::atoi(argv[2]) : 96;
   s.elements_along = argc > 3 ? std::atoi(argv[3]) : 63;
   s.quadratic = true;
-  const MeshData mesh = fibers::tagged_tube(s);
-  const MeshData axis = fibers::tagged_tube_axis(s);
-  std::size_t cells = 0;
-  for (auto t : mesh.cell_types) cells += t == CellType::quadratic_tetra;
-  std::printf("tet10 tube: %zu nodes, %zu tet10\n", mesh.points.size(), cells);
+  const MeshData mesh = files ? read_vtu(argv[1]) : fibers::tagged_tube(s);
+  const MeshData axis = files ? read_vtp(argv[2]) : fibers::tagged_tube_axis(s);
+  std::size_t cells = 0, linear = 0;
+  for (auto t : mesh.cell_types) cells += t == CellType::quadratic_tetra, linear += t == CellType::tetra;
+  std::printf("%s: %zu nodes, %zu tet10, %zu tet4\n", files ? argv[1] : "tet10 tube", mesh.points.size(), cells, linear);
   fibers::HarmonicFiberOptions o;
-  o.angles = {{tags::media, 0.0}, {tags::adventitia, 40.0 * M_PI / 180}};
+  o.angles = {{tags::intima, 0.0}, {tags::media, 0.0}, {tags::adventitia, 40.0 * M_PI / 180}};
   std::vector<std::string> solvers;
   {
     std::string list = argc > 4 ? argv[4] : "gmres_ilu";

@@ -20,6 +20,10 @@ struct LinearSolverSettings {
   int max_iterations = 2000;
   int krylov_size = 200;      // the paper's choice
   int ilu_fill = 4;           // the paper's choice
+  /// gmres_amg: unknowns per mesh node (3 for displacements, 1 for a scalar
+  /// field such as the fibers' Laplace problems). Without a near-null space
+  /// MueLu then uses the constant per component.
+  int amg_equations_per_node = 3;
   int verbosity = 0;
 };
 

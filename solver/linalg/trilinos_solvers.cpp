@@ -68,7 +68,8 @@ class TrilinosSolver : public LinearSolver {
     std::ostringstream o;
     o << "Belos block GMRES (Krylov space " << settings_.krylov_size << ", tol " << settings_.tolerance << ") + ";
     if (settings_.type == "gmres_ilu") o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
-    else o << "MueLu smoothed-aggregation AMG (rigid-body near-null space)";
+    else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space)";
+    else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node)";
     return o.str();
   }
 
@@ -224,7 +225,7 @@ class TrilinosSolver : public LinearSolver {
       Teuchos::ParameterList p;
       p.set("verbosity", std::string(settings_.verbosity > 0 ? "low" : "none"));
       p.set("multigrid algorithm", std::string("sa"));
-      p.set("number of equations", 3);
+      p.set("number of equations", settings_.amg_equations_per_node);
       p.set("coarse: max size", 1000);
       p.set("smoother: type", std::string("CHEBYSHEV"));
       if (modes_.rows() == static_cast<Eigen::Index>(map->getGlobalNumElements()) && modes_.cols() > 0) {

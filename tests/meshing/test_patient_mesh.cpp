@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -218,4 +219,82 @@ TEST(PatientMesh, BadInputIsAnInputError) {
   auto bad = o;
   bad.element = "hex27";
   EXPECT_THROW(meshing::validate(bad), InputError);
+}
+
+TEST(PatientMesh, Tet10QualitySeesMisplacedMidsideNodes) {
+  // One regular-ish tet10 (VTK order: corners, then edges 01 12 02 03 13 23)
+  // with its midside nodes at the edge midpoints: the quadratic map is affine,
+  // the Jacobian ratio 1 and the scaled Jacobian the straight tet's.
+  MeshData m;
+  m.points = {Vector3d(0, 0, 0), Vector3d(1, 0, 0), Vector3d(0.5, std::sqrt(3.0) / 2, 0),
+              Vector3d(0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0))};
+  const int edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+  for (auto& e : edge) m.points.push_back(0.5 * (m.points[std::size_t(e[0])] + m.points[std::size_t(e[1])]));
+  m.add_cell(CellType::quadratic_tetra, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
+  m.cell_data[tags::kLayer] = {1, {double(tags::media)}};
+  const auto straight = meshing::mesh_quality(m);
+  EXPECT_NEAR(straight.min_scaled_jacobian, 1.0, 1e-12);
+  EXPECT_NEAR(straight.min_jacobian_ratio, 1.0, 1e-12);
+  EXPECT_NEAR(straight.mean_edge_length, 1.0, 1e-12);
+  // Midside node of edge 01 pushed most of the way towards the opposite edge
+  // 23: the corner tet is unchanged, but the quadratic map folds (det J < 0
+  // at corner 0 and 1), which the straight-tet measure alone would miss.
+  m.points[4] += 0.8 * (m.points[9] - m.points[4]);
+  const auto bent = meshing::mesh_quality(m);
+  EXPECT_LT(bent.min_jacobian_ratio, 0.0);
+  EXPECT_LT(bent.min_scaled_jacobian, 0.0);
+  // A mild displacement lowers it without inverting.
+  m.points[4] = 0.5 * (m.points[0] + m.points[1]) + Vector3d(0, 0.05, 0.02);
+  const auto mild = meshing::mesh_quality(m);
+  EXPECT_GT(mild.min_jacobian_ratio, 0.5);
+  EXPECT_LT(mild.min_jacobian_ratio, 0.999);
+}
+
+TEST(PatientMesh, Tet10InterfacesShareFacesAndMidsideNodes) {
+  // The tet10 mesh is conforming across the layer interfaces: every corner
+  // face is shared by at most two tets, interface faces exist, and each
+  // edge has one midside node whichever tet (and layer) it is seen from.
+  const auto o = [] { auto x = coarse("tet10"); x.size = 0.5; return x; }();
+  const auto w = meshing::wall_sections(tube_surface(kRl), tube_surface(kRw), tube_centerline(), o);
+  const MeshData m = meshing::mesh_wall_sections(w, o, std::filesystem::temp_directory_path() / "stentsim_test_tube10.msh");
+  const auto& layer = m.cell_data.at(tags::kLayer);
+  std::map<std::array<std::int64_t, 3>, std::set<int>> face_layers;
+  std::map<std::array<std::int64_t, 3>, int> face_count;
+  std::map<std::pair<std::int64_t, std::int64_t>, std::int64_t> midside;
+  std::map<std::pair<std::int64_t, std::int64_t>, std::set<int>> edge_layers;
+  const int edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+  std::size_t tets = 0;
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    if (m.cell_types[c] != CellType::quadratic_tetra) continue;
+    ++tets;
+    const auto n = m.cell(c);
+    static const int f[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+    for (auto& ff : f) {
+      std::array<std::int64_t, 3> k = {n[std::size_t(ff[0])], n[std::size_t(ff[1])], n[std::size_t(ff[2])]};
+      std::sort(k.begin(), k.end());
+      ++face_count[k];
+      face_layers[k].insert(int(layer.at(c)));
+    }
+    for (int e = 0; e < 6; ++e) {
+      auto key = std::minmax(n[std::size_t(edge[e][0])], n[std::size_t(edge[e][1])]);
+      auto [it, fresh] = midside.emplace(key, n[std::size_t(4 + e)]);
+      ASSERT_EQ(it->second, n[std::size_t(4 + e)]) << "edge seen with two midside nodes";
+      edge_layers[key].insert(int(layer.at(c)));
+      // Straight midside nodes (Mesh.SecondOrderLinear).
+      EXPECT_LT((m.points[std::size_t(n[std::size_t(4 + e)])] -
+                 0.5 * (m.points[std::size_t(key.first)] + m.points[std::size_t(key.second)])).norm(), 1e-9);
+    }
+  }
+  std::size_t interface_faces = 0, interface_edges = 0;
+  for (auto& [k, cnt] : face_count) {
+    ASSERT_LE(cnt, 2);
+    interface_faces += face_layers[k].size() == 2;
+  }
+  for (auto& [k, ls] : edge_layers) interface_edges += ls.size() >= 2;
+  std::printf("tet10 tube: %zu tets, %zu interface faces, %zu edges shared by two layers\n", tets, interface_faces, interface_edges);
+  EXPECT_GT(interface_faces, 50u);
+  EXPECT_GT(interface_edges, 50u);
+  const auto q = meshing::mesh_quality(m);
+  EXPECT_NEAR(q.min_jacobian_ratio, 1.0, 1e-9);
+  EXPECT_GT(q.min_scaled_jacobian, 0.1);
 }

@@ -16,7 +16,7 @@ namespace stentsim::cli {
 
 void register_fibers(CLI::App& app) {
   struct Args {
-    std::string mesh, centerline, out, solver = "gmres_ilu";
+    std::string mesh, centerline, out, solver = fibers::HarmonicFiberOptions{}.linear_solver;
     double intima = 0, media = 0, adventitia = 40, weight = 0.5;  // deg from circumferential (paper 4.2)
   };
   auto a = std::make_shared<Args>();
@@ -29,7 +29,7 @@ void register_fibers(CLI::App& app) {
   sub->add_option("--adventitia-angle", a->adventitia, "Adventitia fiber angle (+/-) from circumferential, deg")->capture_default_str();
   sub->add_option("--centerline-weight", a->weight, "Weight of the centerline tangent vs grad of the longitudinal coordinate (0..1)")
       ->capture_default_str();
-  sub->add_option("--linear-solver", a->solver, "direct | gmres_ilu | eigen_lu")->capture_default_str();
+  sub->add_option("--linear-solver", a->solver, "gmres_ilu | gmres_amg | direct | eigen_lu")->capture_default_str();
   on(sub, [a] {
     fibers::HarmonicFiberOptions o;
     const double rad = M_PI / 180.0;
