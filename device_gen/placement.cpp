@@ -10,6 +10,7 @@
 #include "common/config.hpp"
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "common/stenosis_site.hpp"
 #include "common/units.hpp"
 #include "device_gen/surface_distance.hpp"
 
@@ -53,7 +54,15 @@ Placement compute_placement(const PlacementParams& prm, const Centerline& cl, co
                                  P.balloon_length));
   const double L = balloon.length;
 
-  // 1. The site.
+  // 1. The site. The smoothed inscribed radius at the centerline samples
+  // against a straight reference line on its upper envelope.
+  std::vector<double> smoothed(cl.abscissa.size());
+  for (std::size_t i = 0; i < smoothed.size(); ++i) smoothed[i] = cl.smoothed_radius(cl.abscissa[i], prm.radius_window);
+  const double lo = cl.begin() + prm.end_exclusion, hi = cl.end() - prm.end_exclusion;
+  std::size_t inner = 0;
+  for (double s : cl.abscissa) inner += (s >= lo && s <= hi) ? 1 : 0;
+  std::optional<TaperedStenosis> taper;
+  if (inner >= 3) taper = stenosis_discounting_taper(cl.abscissa, smoothed, lo, hi);
   if (prm.site_abscissa) {
     P.site_abscissa = *prm.site_abscissa;
     P.site_chosen_by = "given";
@@ -62,24 +71,25 @@ Placement compute_placement(const PlacementParams& prm, const Centerline& cl, co
                                    P.site_abscissa, cl.source, cl.begin(), cl.end()));
   } else {
     P.site_chosen_by = "narrowest";
-    double best = std::numeric_limits<double>::infinity();
-    bool any = false;
-    for (double s : cl.abscissa) {
-      if (s < cl.begin() + prm.end_exclusion || s > cl.end() - prm.end_exclusion) continue;
-      const double r = cl.smoothed_radius(s, prm.radius_window);
-      if (r < best) {
-        best = r;
-        P.site_abscissa = s;
-        any = true;
-      }
-    }
-    if (!any)
-      throw InputError(fmt::format("placement: the centerline of {} ({:.4g} mm) is shorter than twice end_exclusion ({} mm)",
+    // Narrowest relative to the vessel's taper (common/stenosis_site.hpp, the
+    // rule of the segmentation ROI): a distally narrowing healthy lumen must
+    // not win over a mid-vessel stenosis.
+    if (inner < 3)
+      throw InputError(fmt::format("placement: the centerline of {} ({:.4g} mm) has fewer than three samples more than "
+                                   "end_exclusion ({} mm) from its ends",
                                    cl.source, cl.end() - cl.begin(), prm.end_exclusion));
+    P.site_abscissa = taper->abscissa;
   }
   P.site_point = cl.point_at(P.site_abscissa);
   P.site_radius = cl.radius_at(P.site_abscissa);
   P.site_smoothed_radius = cl.smoothed_radius(P.site_abscissa, prm.radius_window);
+  // The reference (healthy) radius at the site from the same line, so the
+  // percent stenosis follows the segmentation ROI's rule; a given site is
+  // measured against the line fitted over the same range.
+  if (taper) {
+    P.site_reference_radius = taper->reference_radius + taper->slope * (P.site_abscissa - taper->abscissa);
+    P.reference_taper = taper->slope;
+  }
 
   // 2. The balloon ends.
   P.proximal_abscissa = P.site_abscissa - 0.5 * L;

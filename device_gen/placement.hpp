@@ -2,7 +2,9 @@
 // Placement of the stenting device (paper 2.4; DESIGN.md §5 Placement, §8
 // device sizing and reproducibility):
 // 1. the stenosis site: the narrowest smoothed inscribed radius along the
-//    centerline (ends excluded), or a given abscissa;
+//    centerline (ends excluded) relative to a straight reference line on the
+//    radius's upper envelope (common/stenosis_site.hpp: discounts the vessel
+//    taper, the same rule as the segmentation ROI), or a given abscissa;
 // 2. the balloon ends at +- balloon length / 2 by arc length (an error says
 //    by how much the balloon does not fit);
 // 3. the centerline resampled at a fixed spacing between the ends; a cubic
@@ -58,6 +60,12 @@ struct Placement {
   std::string site_chosen_by;  // "narrowest" | "given"
   Eigen::Vector3d site_point = Eigen::Vector3d::Zero();
   double site_radius = 0, site_smoothed_radius = 0;
+  // Taper reference line at the site (0 when fewer than three samples lie
+  // between the excluded ends) and its slope dr_ref/ds.
+  double site_reference_radius = 0, reference_taper = 0;
+  double percent_diameter_stenosis() const {
+    return site_reference_radius > 0 ? 100.0 * (1.0 - site_smoothed_radius / site_reference_radius) : 0.0;
+  }
   double proximal_abscissa = 0, distal_abscissa = 0;
   // Device used for the envelope.
   double balloon_length = 0, balloon_outer_diameter = 0, stent_length = 0, stent_envelope_diameter = 0;

@@ -73,6 +73,9 @@ void write_placement_yaml(const Placement& P, const std::filesystem::path& file)
   e << YAML::Key << "inscribed_radius" << YAML::Value << P.site_radius;
   e << YAML::Key << "smoothed_inscribed_radius" << YAML::Value << P.site_smoothed_radius;
   e << YAML::Key << "lumen_diameter" << YAML::Value << 2.0 * P.site_smoothed_radius;
+  e << YAML::Key << "reference_radius" << YAML::Value << P.site_reference_radius;  // taper line; 0: not fitted
+  e << YAML::Key << "reference_taper" << YAML::Value << P.reference_taper;
+  e << YAML::Key << "percent_diameter_stenosis" << YAML::Value << P.percent_diameter_stenosis();
   e << YAML::EndMap;
   e << YAML::Key << "balloon" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "length" << YAML::Value << P.balloon_length;
@@ -150,6 +153,11 @@ Placement read_placement_yaml(const std::filesystem::path& file) {
   P.site_point = r.point("site.point");
   P.site_radius = r.number("site.inscribed_radius");
   P.site_smoothed_radius = r.number("site.smoothed_inscribed_radius");
+  // The taper reference came later: files written before it lack the keys.
+  if (r.root["site"] && r.root["site"]["reference_radius"]) {
+    P.site_reference_radius = r.number("site.reference_radius");
+    P.reference_taper = r.number("site.reference_taper");
+  }
   P.balloon_length = r.number("balloon.length");
   P.balloon_outer_diameter = r.number("balloon.outer_diameter");
   P.proximal_abscissa = r.number("balloon.proximal_abscissa");

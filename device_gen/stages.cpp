@@ -49,7 +49,15 @@ void run_placement_stage(const PlacementParams& params, const std::filesystem::p
   write_vtp(out_balloon_centerline_vtp.string(), polyline);
 
   summary.set("stenosis_abscissa", P.site_abscissa, "mm");
-  summary.set("narrowest_lumen_diameter", 2.0 * P.site_smoothed_radius, "mm");
+  summary.set("narrowest_lumen_diameter", 2.0 * P.site_smoothed_radius, "mm");  // lumen diameter at the site
+  if (P.site_reference_radius > 0) {
+    summary.set("reference_lumen_diameter", 2.0 * P.site_reference_radius, "mm");
+    summary.set("stenosis_percent_diameter", P.percent_diameter_stenosis(), "%");
+    summary.set("reference_taper", P.reference_taper);  // dr_ref/ds
+    summary.note("stenosis_percent_diameter", "smoothed lumen diameter at the site against a straight reference line "
+                                              "fitted to the radius's upper envelope (discounts the vessel taper; the "
+                                              "segmentation ROI's rule, common/stenosis_site.hpp)");
+  }
   summary.set("balloon_proximal_abscissa", P.proximal_abscissa, "mm");
   summary.set("balloon_distal_abscissa", P.distal_abscissa, "mm");
   summary.set("placement_min_clearance", P.clearance_min, "mm");

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/stenosis_site.hpp"
 #include "segmentation_io/branch_extraction.hpp"
 
 namespace stentsim::segmentation {
@@ -18,21 +19,10 @@ namespace stentsim::segmentation {
 /// vessel from the inlet.
 Eigen::Vector3d farthest_point_along_surface(const TriSurface& tree, const Eigen::Vector3d& from, double inset);
 
-/// The stenosis of a tapering vessel: coronary lumens narrow distally, so the
-/// narrowest radius can be a healthy distal end. A straight reference line
-/// r_ref(s) is fitted to the upper envelope of the radius (least squares,
-/// repeated on the samples at or above the previous line less 2 % of its
-/// mean, so the stenosis drops out of the fit), and the site is where
-/// r(s) / r_ref(s) is smallest, between lo and hi.
-struct TaperedStenosis {
-  double abscissa = 0;          // mm
-  double radius = 0;            // mm, lumen radius there
-  double reference_radius = 0;  // mm, r_ref at the site
-  double slope = 0;             // dr_ref/ds (negative: narrowing distally)
-  double percent_diameter() const { return 100.0 * (1.0 - radius / reference_radius); }
-};
-TaperedStenosis stenosis_discounting_taper(const std::vector<double>& abscissa, const std::vector<double>& radius,
-                                           double lo, double hi);
+/// The taper-discounted stenosis site lives in common/ (shared with the
+/// device placement).
+using stentsim::TaperedStenosis;
+using stentsim::stenosis_discounting_taper;
 
 /// The part of a vessel segment within ±length/2 (along its centerline) of
 /// the stenosis (stenosis_discounting_taper between a local radius from each
