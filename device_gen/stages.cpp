@@ -54,7 +54,7 @@ void run_placement_stage(const PlacementParams& params, const std::filesystem::p
     summary.set("reference_lumen_diameter", 2.0 * P.site_reference_radius, "mm");
     summary.set("stenosis_percent_diameter", P.percent_diameter_stenosis(), "%");
     summary.set("reference_taper", P.reference_taper);  // dr_ref/ds
-    summary.note("stenosis_percent_diameter", "smoothed lumen diameter at the site against a straight reference line "
+    summary.note("stenosis_rule", "smoothed lumen diameter at the site against a straight reference line "
                                               "fitted to the radius's upper envelope (discounts the vessel taper; the "
                                               "segmentation ROI's rule, common/stenosis_site.hpp)");
   }
