@@ -86,6 +86,15 @@ Mat3 cylindrical_frame(const Vec3& x, const Vec3& origin, const Vec3& axis) {
   return q;
 }
 
+// Multiplier DOFs of a direction condition on `nodes` nodes: 2 per "moves only along d" node, 1 per
+// "fixed along d" node (the stent file's axial fixation, taken with direction: file).
+GlobalDof direction_multiplier_count(const ConditionDesc& c, const beams::BeamBodyDesc& desc, std::size_t nodes) {
+  GlobalDof count = 0;
+  for (std::size_t k = 0; k < nodes; ++k)
+    count += c.direction_from_file && desc.fixations.at(k).axial ? 1 : 2;
+  return count;
+}
+
 // Clamp, dead point force/moment and "moves only along a direction" on beam nodes.
 void add_beam_condition(const SceneDesc& scene, const ConditionDesc& c, Built& out,
                         const std::map<std::string, GlobalDof>& multipliers) {
@@ -140,6 +149,7 @@ void add_beam_condition(const SceneDesc& scene, const ConditionDesc& c, Built& o
     return;
   }
   std::size_t k = 0;
+  GlobalDof direction_offset = 0;  // next multiplier of a direction condition
   for (int n : nodes) {
     const beams::BeamNodeDofs& d = beam.dofs()[static_cast<std::size_t>(n)];
     auto fix3 = [&](const std::array<GlobalDof, 3>& dofs) {
@@ -160,11 +170,21 @@ void add_beam_condition(const SceneDesc& scene, const ConditionDesc& c, Built& o
                                              [curve](double t) { return curve(t); });
         break;
       case ConditionDesc::Type::direction: {
+        // The stent file's axial fixation is "fixed along d" (d·u = 0, one multiplier, free to expand
+        // radially); the radial ones and a given direction are "moves only along d" (two multipliers).
+        // Multipliers are laid out node after node in that order (see direction_multiplier_count).
         Eigen::Vector3d dir = c.vector;
+        const bool fixed_along = c.direction_from_file && desc.fixations[k].axial;
         if (c.direction_from_file) dir = desc.fixations[k].direction;
-        const GlobalDof m0 = multipliers.at(c.name) + 2 * static_cast<GlobalDof>(k);
-        model.add_term<beams::DirectionConstraintTerm>(fmt::format("{}@{}", c.name, n), d.pos, dir,
-                                                       std::array<GlobalDof, 2>{m0, m0 + 1});
+        const GlobalDof m0 = multipliers.at(c.name) + direction_offset;
+        const std::string term = fmt::format("{}@{}", c.name, n);
+        if (fixed_along) {
+          model.add_term<beams::DirectionConstraintTerm>(term, d.pos, dir, m0);
+          direction_offset += 1;
+        } else {
+          model.add_term<beams::DirectionConstraintTerm>(term, d.pos, dir, std::array<GlobalDof, 2>{m0, m0 + 1});
+          direction_offset += 2;
+        }
         break;
       }
       default:
@@ -250,8 +270,10 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
   for (const auto& c : scene.conditions) {
     if (c.type != ConditionDesc::Type::direction && c.type != ConditionDesc::Type::radial_displacement) continue;
     const auto nodes = beams::select_beam_nodes(*out->beam_desc.at(c.body), c.node);
-    const GlobalDof per_node = c.type == ConditionDesc::Type::direction ? 2 : 1;
-    multipliers[c.name] = model.dofs.allocate(c.name, per_node * static_cast<GlobalDof>(nodes.size()));
+    const GlobalDof count = c.type == ConditionDesc::Type::direction
+                                ? direction_multiplier_count(c, *out->beam_desc.at(c.body), nodes.size())
+                                : static_cast<GlobalDof>(nodes.size());
+    multipliers[c.name] = model.dofs.allocate(c.name, count);
   }
   model.size_constraints();
   std::map<GlobalDof, std::string> framed, globally_fixed;  // node first DOF -> condition name

@@ -193,6 +193,35 @@ TEST(BeamConditions, NodeMovesOnlyAlongDirection) {
   EXPECT_GT(c.reaction(sys.u).norm(), 0.1 * F.norm());  // and the constraint carried load
 }
 
+TEST(BeamConditions, FixedAlongDirectionKeepsTheNodeInItsPlane) {
+  // "Fixed along d" (the stent's axial fixation): one multiplier, d·u = 0; the
+  // tip moves freely in the plane normal to d and the reaction is along d.
+  const int n = 8;
+  BeamBodyDefinition def = curve_body(straight_x(), L, n, square());
+  GlobalDof ndof = 0;
+  auto dofs = number_beam_dofs(def, 0, &ndof);
+  dofs[0].pos = dofs[0].rot = dofs[0].tan = {-1, -1, -1};
+  const GlobalDof lam = ndof;
+  ndof += 1;
+  BeamTerm beam("b", def, dofs);
+  const Eigen::Vector3d d = Eigen::Vector3d(-1, 1, 0.5).normalized();
+  DirectionConstraintTerm c("fix", dofs[n].pos, d, lam);
+  EXPECT_EQ(c.kind(), DirectionConstraintTerm::Kind::normal);
+  const Eigen::Vector3d F(0.25, 1.5, -1.0);  // tip deflection ~ F L³/(3EI) ≈ 0.7 (free in the plane)
+  NodalLoadTerm f("f", dofs[n].pos, F, [](double t) { return t; });
+  TestSystem sys(ndof);
+  sys.terms = {&beam, &f, &c};
+  for (int step = 1; step <= 5; ++step) sys.solve(step / 5.0, 1e-12 * L);
+  const Eigen::Vector3d u = beam.position(sys.u, n) - def.nodes[n].position;
+  const Eigen::Vector3d reaction = c.reaction(sys.u);
+  std::printf("fixed along d: d·u %.2e, in-plane move %.4f; reaction off d %.2e\n", u.dot(d), (u - u.dot(d) * d).norm(),
+              (reaction - reaction.dot(d) * d).norm());
+  EXPECT_LT(std::abs(u.dot(d)), 1e-12);
+  EXPECT_GT((u - u.dot(d) * d).norm(), 0.05);  // it did move
+  EXPECT_LT((reaction - reaction.dot(d) * d).norm(), 1e-12 * F.norm());
+  EXPECT_GT(std::abs(reaction.dot(d)), 0.1 * F.norm());  // and the constraint carried load
+}
+
 TEST(BeamConditions, BadInputIsReported) {
   BeamBodyDefinition def = curve_body(straight_x(), L, 2, square());
   GlobalDof ndof = 0;

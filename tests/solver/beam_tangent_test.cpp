@@ -106,8 +106,10 @@ TEST(BeamTangent, HermiteBodyWithLoadsAndConstraint) {
   NodalLoadTerm f("f", dofs[3].pos, Eigen::Vector3d(1, 2, 3), nullptr);
   NodalLoadTerm m("m", dofs[3].rot, Eigen::Vector3d(-1, 0.5, 2), nullptr);
   DirectionConstraintTerm c("c", dofs[2].pos, Eigen::Vector3d(1, 1, 0), {lam, lam + 1});
+  n += 1;
+  DirectionConstraintTerm c2("c2", dofs[4].pos, Eigen::Vector3d(0.3, -1, 2), lam + 2);  // fixed along d
   TestSystem sys(n);
-  sys.terms = {&beam, &q, &f, &m, &c};
+  sys.terms = {&beam, &q, &f, &m, &c, &c2};
   randomize(beam, sys.u, 42);
   const FdResult r = fd_check(beam, sys, 1e-5);
   std::printf("hermite 3 elements + loads: FD tangent rel. error %.3e\n", r.tangent_error);
