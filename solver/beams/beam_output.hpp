@@ -9,6 +9,12 @@
 //   TorsionalMoment   M₁                         [N·mm]
 //   BendingMoment     ‖M_b‖ = √(M₂² + M₃²)       [N·mm]
 //   OuterFibreStress  |N|/A + ‖M_b‖ R / I        [MPa]
+//                     exact for circular sections (R the radius, I = πR⁴/4);
+//                     for sections given by values (section: {A, I2, ...},
+//                     no radius) it is an estimate: R = √(A/π) (the circle of
+//                     equal area) and I = I₂, also for bending about d₃ — the
+//                     array is still written, so read it as indicative only
+//                     for non-circular sections (every stent section is circular)
 //   Displacement      r − r₀                     [mm]
 // and, for elasto-plastic sections (App. C), from the committed history of the
 // nearest Gauss point:
