@@ -21,10 +21,11 @@ MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int sa
   DataArray &radius = arr("Radius", 1), &d1 = arr("TriadD1", 3), &d2 = arr("TriadD2", 3), &d3 = arr("TriadD3", 3);
   DataArray &axial = arr("AxialForce", 1), &shear = arr("ShearForce", 2), &torsion = arr("TorsionalMoment", 1);
   DataArray &bending = arr("BendingMoment", 1), &stress = arr("OuterFibreStress", 1), &disp = arr("Displacement", 3);
-  // Elasto-plastic sections (App. C): the committed history of the nearest
-  // Gauss point (BeamTerm::sample), the outer-fibre plastic strain R·‖Ω_pl‖
-  // and whether the section is on the yield surface (‖M_b‖ ≥ (1 − 1e-6)·M_y,
-  // M_y = M_y0 + H·I·Ω̄_pl, after some plastic flow: yielding or at yield).
+  // Elasto-plastic sections (App. C): BendingMoment, the plastic history and
+  // Yielding are the committed ones of the nearest Gauss point
+  // (BeamTerm::sample; the plastic state exists only at Gauss points), the
+  // outer-fibre plastic strain is R·‖Ω_pl‖, and Yielding = 1 where that Gauss
+  // point flowed in the last committed step.
   const bool plastic = sec.plastic.has_value();
   DataArray* kpl = plastic ? &arr("PlasticCurvature", 3) : nullptr;
   DataArray* kacc = plastic ? &arr("AccumulatedPlasticCurvature", 1) : nullptr;
@@ -59,8 +60,7 @@ MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int sa
         for (int c = 0; c < 3; ++c) kpl->values.push_back(s.plastic.plastic_curvature[c]);
         kacc->values.push_back(s.plastic.accumulated);
         eps->values.push_back(law.radius * s.plastic.plastic_curvature.norm());
-        const double My = law.M_y0 + law.hardening_modulus() * law.inertia() * s.plastic.accumulated;
-        yielding->values.push_back(s.plastic.accumulated > 0.0 && Mb >= (1.0 - 1e-6) * My ? 1.0 : 0.0);
+        yielding->values.push_back(s.yielding ? 1.0 : 0.0);
       }
     }
     m.add_cell(CellType::polyline, ids);

@@ -90,6 +90,7 @@ BeamTerm::BeamTerm(std::string name, BeamBodyDefinition body, std::vector<BeamNo
   for (const ElementReference& r : refs_) hist_offset_.push_back(ngp), ngp += r.points.size();
   hist_committed_.assign(ngp, PlasticBendingHistory{});
   hist_trial_ = hist_committed_;
+  yielded_committed_.assign(ngp, 0);
   work_trial_.assign(refs_.size(), 0.0);
   committed_.resize(nn);
   for (int n = 0; n < nn; ++n) committed_[n] = body_.nodes[n].triad;
@@ -177,6 +178,9 @@ void BeamTerm::commit() {
                            "that of another iterate");
   committed_ = accepted_;
   if (body_.section.plastic) {
+    // "flowed in this step": the accumulated plastic curvature grew
+    for (std::size_t g = 0; g < hist_trial_.size(); ++g)
+      yielded_committed_[g] = hist_trial_[g].accumulated > hist_committed_[g].accumulated ? 1 : 0;
     hist_committed_ = hist_trial_;
     for (double w : work_trial_) plastic_work_committed_ += w;
     std::fill(work_trial_.begin(), work_trial_.end(), 0.0);
@@ -208,17 +212,29 @@ SectionState BeamTerm::sample(const Eigen::VectorXd& u, std::size_t e, double xi
   std::array<Eigen::Quaterniond, 3> q;
   gather(u, e, x, q);
   const ShapePoint p = refs_[e].at(xi);
-  // Plastic sections between Gauss points: the history of the nearest Gauss
-  // point (piecewise constant, as output only).
-  const PlasticBendingHistory* h = nullptr;
-  if (body_.section.plastic && !refs_[e].points.empty()) {
-    std::size_t best = 0;
-    for (std::size_t g = 1; g < refs_[e].points.size(); ++g)
-      if (std::abs(refs_[e].points[g].xi - xi) < std::abs(refs_[e].points[best].xi - xi)) best = g;
-    h = &hist_committed_[hist_offset_[e] + best];
-  }
-  return body_.interpolation == BeamInterpolation::hermite3 ? section_state<4, 3>(p, body_.section, x, q, h)
-                                                            : section_state<2, 2>(p, body_.section, x, q, h);
+  const bool hermite = body_.interpolation == BeamInterpolation::hermite3;
+  if (!body_.section.plastic || refs_[e].points.empty())
+    return hermite ? section_state<4, 3>(p, body_.section, x, q) : section_state<2, 2>(p, body_.section, x, q);
+  // Plastic sections between Gauss points: the plastic state exists only at
+  // the Gauss points. Rerunning the return at ξ from a neighbour's history
+  // would give a moment that is no one's (a sawtooth along the strut, and
+  // spurious "yielding" where no Gauss point flowed), so the bending moment,
+  // the history and the yielding flag are those of the nearest Gauss point
+  // (piecewise constant); kinematics, forces and torsion are sampled at ξ.
+  std::size_t best = 0;
+  for (std::size_t g = 1; g < refs_[e].points.size(); ++g)
+    if (std::abs(refs_[e].points[g].xi - xi) < std::abs(refs_[e].points[best].xi - xi)) best = g;
+  const PlasticBendingHistory* h = &hist_committed_[hist_offset_[e] + best];
+  SectionState s = hermite ? section_state<4, 3>(p, body_.section, x, q, h) : section_state<2, 2>(p, body_.section, x, q, h);
+  const ShapePoint& pg = refs_[e].points[best];
+  const SectionState g =
+      hermite ? section_state<4, 3>(pg, body_.section, x, q, h) : section_state<2, 2>(pg, body_.section, x, q, h);
+  s.M[1] = g.M[1], s.M[2] = g.M[2];
+  s.plastic = *h;
+  s.yielding = yielded_committed_[hist_offset_[e] + best] != 0;
+  const double EI = body_.section.plastic->E * body_.section.plastic->inertia();
+  s.stored_energy_density = 0.5 * (s.Gamma.dot(s.F) + s.Omega[0] * s.M[0] + s.M.tail<2>().squaredNorm() / EI);
+  return s;
 }
 
 std::vector<SectionState> BeamTerm::section_states(const Eigen::VectorXd& u, std::size_t e) const {
@@ -260,6 +276,7 @@ void BeamTerm::save_history(HistoryArchive& out, const std::string& prefix) cons
       h.insert(h.end(), {g.plastic_curvature[0], g.plastic_curvature[1], g.plastic_curvature[2], g.accumulated});
     out.put(prefix + "plastic", h);
     out.put(prefix + "plastic_work", plastic_work_committed_);
+    out.put(prefix + "yielded", std::vector<double>(yielded_committed_.begin(), yielded_committed_.end()));
   }
 }
 
@@ -276,6 +293,13 @@ void BeamTerm::load_history(const HistoryArchive& in, const std::string& prefix)
     }
     hist_trial_ = hist_committed_;
     plastic_work_committed_ = in.get_scalar(prefix + "plastic_work");
+    // checkpoints written before the flag existed: no Gauss point flowed
+    if (in.has(prefix + "yielded")) {
+      const std::vector<double>& y = in.get(prefix + "yielded", static_cast<long long>(yielded_committed_.size()));
+      for (std::size_t g = 0; g < y.size(); ++g) yielded_committed_[g] = y[g] != 0.0 ? 1 : 0;
+    } else {
+      std::fill(yielded_committed_.begin(), yielded_committed_.end(), 0);
+    }
     std::fill(work_trial_.begin(), work_trial_.end(), 0.0);
   }
   accepted_serial_ = assembled_serial_ = ++state_serial_;

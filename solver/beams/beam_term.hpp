@@ -73,7 +73,8 @@ class BeamTerm : public Term {
   void rollback() override;
   /// Restart: the committed nodal triads (quaternions w, x, y, z per node) under
   /// "<prefix>triads"; plastic sections add "<prefix>plastic" (Ω_pl and Ω̄_pl
-  /// per Gauss point) and "<prefix>plastic_work".
+  /// per Gauss point), "<prefix>plastic_work" and "<prefix>yielded" (1 per Gauss
+  /// point that flowed in the last committed step; optional on load).
   bool has_history() const override { return true; }
   void save_history(HistoryArchive& out, const std::string& prefix) const override;
   void load_history(const HistoryArchive& in, const std::string& prefix) override;
@@ -93,9 +94,16 @@ class BeamTerm : public Term {
   Eigen::Vector3d position(const Eigen::VectorXd& u, int node) const;
   Eigen::Vector3d tangent(const Eigen::VectorXd& u, int node) const;
 
-  /// Section states at the quadrature points of element e.
+  /// Section states at the quadrature points of element e: the return at u
+  /// from the committed history (at the committed u: the committed moment;
+  /// `yielding` there is Φ_trial > 0 of that return, see yielded_last_step()).
   std::vector<SectionState> section_states(const Eigen::VectorXd& u, std::size_t e) const;
   /// Section state at any ξ ∈ [−1, 1] of element e (output sampling).
+  /// Elasto-plastic sections: position, triad, strains, forces and torsion at
+  /// ξ; the bending moment (M₂, M₃), the plastic history and `yielding` are the
+  /// committed ones of the nearest Gauss point (piecewise constant), since the
+  /// plastic state exists only there; `yielding` = that point flowed in the
+  /// last committed step (its Ω̄_pl grew).
   SectionState sample(const Eigen::VectorXd& u, std::size_t e, double xi) const;
   /// Stored (elastic) energy of the body at u and the current triads; for
   /// plastic sections from the return of the committed history.
@@ -105,6 +113,9 @@ class BeamTerm : public Term {
   /// (committed, and the trial state of the last assemble()).
   const PlasticBendingHistory& committed_plastic(std::size_t e, int g) const { return hist_committed_[hist_offset_[e] + g]; }
   const PlasticBendingHistory& trial_plastic(std::size_t e, int g) const { return hist_trial_[hist_offset_[e] + g]; }
+  /// Did Gauss point g of element e flow in the last committed step? (Set by
+  /// commit(), kept by rollback(), saved in checkpoints.)
+  bool yielded_last_step(std::size_t e, int g) const { return yielded_committed_[hist_offset_[e] + g] != 0; }
   /// Plastic work ∫∫ M_b·dΩ_pl ds summed over committed steps (= ∫ M_y dΩ̄,
   /// exact for linear hardening) [N·mm].
   double plastic_work() const { return plastic_work_committed_; }
@@ -120,6 +131,7 @@ class BeamTerm : public Term {
   std::vector<Eigen::Quaterniond> committed_, accepted_, trial_;
   std::vector<std::size_t> hist_offset_;  // first Gauss point of element e
   std::vector<PlasticBendingHistory> hist_committed_, hist_trial_;
+  std::vector<char> yielded_committed_;  // per Gauss point: flowed in the last committed step
   std::vector<double> work_trial_;  // plastic work increment of element e in the last assemble
   double plastic_work_committed_ = 0.0;
   // Which state the trial history belongs to: trial()/set_rotation() start a

@@ -9,7 +9,10 @@
 // 11.531 %; from the test assembly of part 2, commit 638ed22, which prescribed
 // the crowns by Dirichlet conditions instead of multipliers); the 8 peaks and
 // the 8 valleys agree in radius to 1e-6; the largest ‖M_b‖ is next to a crown
-// and exceeds M_y0; crowns yield; external work = stored + plastic work within
+// and exceeds M_y0; crowns yield; the written BendingMoment's maximum is the
+// Gauss-point maximum of the summary at the peak and at the end, and no point
+// yields at the end (the plastic output is the committed Gauss-point state,
+// BeamTerm::sample); external work = stored + plastic work within
 // 1 %; every crown joint keeps its reference kink to 1e-10 rad. Restart from a
 // checkpoint in the expansion phase matches the uninterrupted run to 1e-10.
 #include <fmt/format.h>
@@ -135,7 +138,27 @@ void check_ring(int eps, double D_end_ref, double recoil_ref) {
   EXPECT_LT((pmax - pmin) / pmax, 1e-6);
   EXPECT_LT((vmax - vmin) / vmax, 1e-6);
   EXPECT_LT(kink, 1e-10);
-  // At the peak the largest sampled ‖M_b‖ lies in an element that ends at a crown, and crowns yield.
+  // The written BendingMoment of the plastic ring is the committed Gauss-point
+  // moment (BeamTerm::sample): its maximum is the Gauss-point maximum of the
+  // summary, at the peak and at the end.
+  auto array_max = [](const MeshData& m, const char* name) {
+    double x = 0.0;
+    for (double v : m.point_data.at(name).values) x = std::max(x, v);
+    return x;
+  };
+  auto count_set = [](const MeshData& m, const char* name) {
+    int n = 0;
+    for (double v : m.point_data.at(name).values) n += v > 0.5 ? 1 : 0;
+    return n;
+  };
+  std::printf("  max written M_b %.6f (peak) %.6f (end) N mm; yielding samples %d (peak) %d (end) of %zu\n",
+              array_max(mp, "BendingMoment"), array_max(me, "BendingMoment"), count_set(mp, "Yielding"),
+              count_set(me, "Yielding"), mp.points.size());
+  EXPECT_NEAR(array_max(mp, "BendingMoment"), qoi(s, "max_bending_moment_peak"), 1e-9 * qoi(s, "max_bending_moment_peak"));
+  EXPECT_NEAR(array_max(me, "BendingMoment"), qoi(s, "max_bending_moment_end"), 1e-9 * qoi(s, "max_bending_moment_peak"));
+  EXPECT_EQ(count_set(me, "Yielding"), 0);  // no Gauss point flows while the ring is released
+  // At the peak the largest (Gauss-point) ‖M_b‖ lies in an element that ends at a crown, and crowns yield
+  // (Yielding: the crown's nearest Gauss point flowed in the last expansion step).
   const DataArray& Mb = mp.point_data.at("BendingMoment");
   std::size_t arg = 0;
   for (std::size_t p = 0; p < Mb.tuples(); ++p)
@@ -158,7 +181,7 @@ void check_ring(int eps, double D_end_ref, double recoil_ref) {
   std::filesystem::remove_all(dir);
 }
 
-double max_difference(const MeshData& a, const MeshData& b, const std::string& array) {
+[[maybe_unused]] double max_difference(const MeshData& a, const MeshData& b, const std::string& array) {
   const DataArray& x = a.point_data.at(array);
   const DataArray& y = b.point_data.at(array);
   EXPECT_EQ(x.values.size(), y.values.size());
@@ -169,12 +192,18 @@ double max_difference(const MeshData& a, const MeshData& b, const std::string& a
 
 }  // namespace
 
+// One source, two binaries (tests/solver/CMakeLists.txt): the 3 el/strut run
+// and the restart are quick (CI), the 6 el/strut run is validation.
+#ifndef STENTSIM_RING_VALIDATION
 TEST(BeamRingScene, ExpansionAndRecoilThreeElementsPerStrut) { check_ring(3, 2.299586, 11.554); }
+#else
 TEST(BeamRingScene, ExpansionAndRecoilSixElementsPerStrut) { check_ring(6, 2.300181, 11.531); }
+#endif
 
 // A checkpoint at step 17 (expansion, crowns yielding) holds the plastic
 // history; the run resumed from it crosses the release (t = 20, the frozen
 // reactions are made after the restart) and ends as the uninterrupted run.
+#ifndef STENTSIM_RING_VALIDATION
 TEST(BeamRingScene, RestartFromMidExpansionMatchesUninterruptedRun) {
   const auto dir = fresh_dir("restart");
   files::write_atomic(dir / "scene.yaml", ring_scene(3, 17));
@@ -193,7 +222,7 @@ TEST(BeamRingScene, RestartFromMidExpansionMatchesUninterruptedRun) {
                         "stored_energy_end", "plastic_work_end"})
     dq = std::max(dq, std::abs(qoi(a, k) - qoi(b, k)));
   double du = 0;
-  for (const char* arr : {"Displacement", "BendingMoment", "PlasticCurvature", "AccumulatedPlasticCurvature"})
+  for (const char* arr : {"Displacement", "BendingMoment", "PlasticCurvature", "AccumulatedPlasticCurvature", "Yielding"})
     du = std::max(du, max_difference(frame(dir / "full", 30), frame(dir / "resumed", 30), arr));
   std::printf("ring restart from step 17 of 30: max QoI difference %.2e, max last-frame difference %.2e\n", dq, du);
   EXPECT_LE(dq, 1e-10);
@@ -201,5 +230,7 @@ TEST(BeamRingScene, RestartFromMidExpansionMatchesUninterruptedRun) {
   EXPECT_GT(qoi(b, "plastic_work_end"), 0.0);
   std::filesystem::remove_all(dir);
 }
+
+#endif
 
 }  // namespace stentsim::solver
