@@ -71,7 +71,9 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
     rec.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
     const double eta = t > s.t_start ? elapsed * (s.t_end - t) / (t - s.t_start) : 0.0;
-    log::info("step {} t = {:.4g} dt = {:.3g}: {} Newton its, {} linear its, {} cuts, {:.2f} s, ETA {:.0f} s", step, t,
+    // The progress line names the load reached (issue 6), e.g. "p = 0.12 MPa", when the scene can describe it.
+    const std::string load = s.describe_load ? s.describe_load(t) : fmt::format("t = {:.4g}", t);
+    log::info("step {} {} dt = {:.3g}: {} Newton its, {} linear its, {} cuts, {:.2f} s, ETA {:.0f} s", step, load,
               rec.dt, rec.newton_iterations, rec.linear_iterations, cuts, rec.wall_seconds, eta);
     on_step(rec);
   }

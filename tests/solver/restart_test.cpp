@@ -89,6 +89,10 @@ void check_restart(const std::string& example, const std::string& body, int ever
   const std::string last = "results/" + body + "_" + fmt::format("{:05d}", frames) + ".vtu";
   const double d = max_difference(read_vtu((dir / "full" / last).string()), read_vtu((dir / "resumed" / last).string()),
                                   "Displacement");
+  // A restart that ignored the checkpoint and ran from t = 0 would pass every comparison above: the resumed run
+  // must not have written the frames before its checkpoint.
+  EXPECT_FALSE(std::filesystem::exists(dir / "resumed" / ("results/" + body + "_00001.vtu")))
+      << "the resumed run wrote frame 1: it did not start from the checkpoint";
   std::printf("%s: restart from the last checkpoint (every %d steps) of %d steps, max |Δu| of the last frame = %.2e\n",
               example.c_str(), every, frames, d);
   EXPECT_LE(d, 1e-10);
