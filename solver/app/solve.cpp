@@ -72,6 +72,7 @@ struct Built {
   std::map<std::string, Eigen::Vector3d> tip_rotation;      // accumulated rotation vector per QoI name
   std::vector<std::pair<std::string, FollowerPressure*>> pressures;
   std::map<std::string, beams::RadialDisplacementTerm*> radial;  // radial_displacement conditions by name
+  std::vector<std::pair<GlobalDof, GlobalDof>> direction_multipliers;  // (first, count) per direction condition
   std::vector<std::string> notes;
 };
 
@@ -274,6 +275,7 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
                                 ? direction_multiplier_count(c, *out->beam_desc.at(c.body), nodes.size())
                                 : static_cast<GlobalDof>(nodes.size());
     multipliers[c.name] = model.dofs.allocate(c.name, count);
+    if (c.type == ConditionDesc::Type::direction) out->direction_multipliers.emplace_back(multipliers[c.name], count);
   }
   model.size_constraints();
   std::map<GlobalDof, std::string> framed, globally_fixed;  // node first DOF -> condition name
@@ -336,7 +338,12 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
 }
 
 // ring_expansion QoI (scene.hpp): values kept in one vector so that checkpoints carry them.
-enum RingSlot { kDmax, kMbPeak, kDend, kMbEnd, kExternalWork, kStoredEnd, kPlasticWorkEnd, kD0, kRingSlots };
+enum RingSlot {
+  kDmax, kMbPeak, kDend, kMbEnd, kExternalWork, kStoredEnd, kPlasticWorkEnd, kD0,
+  kRadialForceEnd,      // max |λ| of the radial_displacement conditions (after release: the ramped point forces)
+  kDirectionReactionEnd,  // max |λ| of the direction conditions (e.g. the stent file's axial fixation)
+  kRingSlots
+};
 
 double ring_diameter(const QoiDesc& q, const Built& b, const Eigen::VectorXd& u) {
   const beams::BeamTerm& beam = *b.beams.at(q.body);
@@ -354,6 +361,37 @@ double max_bending_moment(const beams::BeamTerm& beam, const Eigen::VectorXd& u)
   double m = 0.0;
   for (std::size_t e = 0; e < beam.body().elements.size(); ++e)
     for (const auto& st : beam.section_states(u, e)) m = std::max(m, st.M.tail<2>().norm());
+  return m;
+}
+
+/// Collects residuals only (reactions).
+class ResidualAssembler : public Assembler {
+ public:
+  explicit ResidualAssembler(Eigen::Index n) : R(Eigen::VectorXd::Zero(n)) {}
+  void add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& residual,
+           const Eigen::Ref<const Eigen::MatrixXd>&) override {
+    for (std::size_t i = 0; i < dofs.size(); ++i)
+      if (dofs[i] >= 0) R[dofs[i]] += residual[static_cast<Eigen::Index>(i)];
+  }
+  bool wants_tangent() const override { return false; }
+  Eigen::VectorXd R;
+};
+
+/// Largest reaction [N] at the beam's position DOFs held in a nodal frame (fix_cylindrical: mirror
+/// planes, axial fix): the beam's residual there in local components. Every element is evaluated
+/// (rank 0 of 1), so every MPI rank gets the same value.
+double held_position_reaction(beams::BeamTerm& beam, const Model& model, const Eigen::VectorXd& u, double t) {
+  ResidualAssembler a(u.size());
+  beam.assemble(SystemState{u, t, 0.0}, a);
+  double m = 0.0;
+  for (const beams::BeamNodeDofs& d : beam.dofs()) {
+    if (d.pos[0] < 0) continue;
+    const Mat3* q = model.constraints.frame(d.pos[0]);
+    if (!q) continue;
+    const Vec3 local = q->transpose() * Vec3(a.R[d.pos[0]], a.R[d.pos[1]], a.R[d.pos[2]]);
+    for (int i = 0; i < 3; ++i)
+      if (model.constraints.fixed(d.pos[0] + i)) m = std::max(m, std::abs(local[i]));
+  }
   return m;
 }
 
@@ -527,6 +565,13 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
         if (std::abs(r.time - q.time) < tol) v[kDmax] = ring_diameter(q, *built, u), v[kMbPeak] = max_bending_moment(beam, u);
         v[kDend] = ring_diameter(q, *built, u), v[kMbEnd] = max_bending_moment(beam, u);
         v[kStoredEnd] = beam.energy(u), v[kPlasticWorkEnd] = beam.plastic_work();
+        // Reactions at the end (issue 9: after release every crown reaction vanishes): the multipliers
+        // are the forces the conditions apply to the nodes (orthonormal constraint rows), in N.
+        v[kRadialForceEnd] = v[kDirectionReactionEnd] = 0.0;
+        for (const auto& f : now) v[kRadialForceEnd] = std::max(v[kRadialForceEnd], std::abs(f.first));
+        for (const auto& [first, count] : built->direction_multipliers)
+          for (GlobalDof d = first; d < first + count; ++d)
+            v[kDirectionReactionEnd] = std::max(v[kDirectionReactionEnd], std::abs(u[d]));
         continue;
       }
       if (std::abs(r.time - q.time) < tol) qoi[q.name] = qoi_values(q, *built, u);
@@ -578,6 +623,10 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
       summary.set("external_work", v[kExternalWork], "N mm");
       summary.set("stored_energy_end", v[kStoredEnd], "N mm");
       summary.set("plastic_work_end", v[kPlasticWorkEnd], "N mm");
+      summary.set("max_radial_condition_force_end", v[kRadialForceEnd], "N");
+      summary.set("max_direction_condition_reaction_end", v[kDirectionReactionEnd], "N");
+      if (status == 0)
+        summary.set("max_held_position_reaction_end", held_position_reaction(*built->beams.at(q.body), model, u, t_last), "N");
       const double W = v[kExternalWork];
       summary.set("energy_balance_error", W != 0 ? std::abs(W - v[kStoredEnd] - v[kPlasticWorkEnd]) / std::abs(W) : 0.0);
       continue;
