@@ -1,7 +1,8 @@
 #pragma once
 // Beam results for the VTU/PVD output (issue 8): the centerline sampled finer
 // than the nodes (ParaView then draws the curved Hermite shape), one
-// polyline per element, with point arrays
+// polyline per element, with point arrays (section quantities are those of the
+// nearest Gauss point, piecewise constant along an element: BeamTerm::sample)
 //   Radius            section radius (ParaView's Tube filter: "Vary radius by scalar")
 //   TriadD1..D3       the current section triad
 //   AxialForce        N = F₁                     [N]
@@ -21,7 +22,7 @@
 //   PlasticCurvature             Ω_pl, material components   [1/mm]
 //   AccumulatedPlasticCurvature  Ω̄_pl                        [1/mm]
 //   OuterFibrePlasticStrain      R·‖Ω_pl‖                    [-]
-//   Yielding                     1 on the yield surface after plastic flow, else 0
+//   Yielding                     1 where the nearest Gauss point flowed in the last committed step, else 0
 // and cell data ElementId. Section resultants are the material (convected)
 // ones, F = C_F Γ, M = C_M Ω, components in the section triad.
 #include "common/mesh_data.hpp"

@@ -213,27 +213,32 @@ SectionState BeamTerm::sample(const Eigen::VectorXd& u, std::size_t e, double xi
   gather(u, e, x, q);
   const ShapePoint p = refs_[e].at(xi);
   const bool hermite = body_.interpolation == BeamInterpolation::hermite3;
-  if (!body_.section.plastic || refs_[e].points.empty())
-    return hermite ? section_state<4, 3>(p, body_.section, x, q) : section_state<2, 2>(p, body_.section, x, q);
-  // Plastic sections between Gauss points: the plastic state exists only at
-  // the Gauss points. Rerunning the return at ξ from a neighbour's history
-  // would give a moment that is no one's (a sawtooth along the strut, and
-  // spurious "yielding" where no Gauss point flowed), so the bending moment,
-  // the history and the yielding flag are those of the nearest Gauss point
-  // (piecewise constant); kinematics, forces and torsion are sampled at ξ.
+  const auto state = [&](const ShapePoint& at, const PlasticBendingHistory* h) {
+    return hermite ? section_state<4, 3>(at, body_.section, x, q, h) : section_state<2, 2>(at, body_.section, x, q, h);
+  };
+  const SectionState here = state(p, nullptr);
+  if (refs_[e].points.empty()) return here;
+  // Strains and resultants are only reliable at the Gauss points: between
+  // them the interpolated axial and shear strains of a stiff section oscillate
+  // (the 45° bend's |F| is off by up to 55 % at the root sample), and a plastic
+  // state exists only at the Gauss points (rerunning the return at ξ from a
+  // neighbour's history gives a sawtooth moment and spurious yielding). So the
+  // section quantities written at ξ are those of the nearest Gauss point
+  // (piecewise constant along the element); the centerline position and the
+  // triad are evaluated at ξ, so ParaView still shows the curved shape.
   std::size_t best = 0;
   for (std::size_t g = 1; g < refs_[e].points.size(); ++g)
     if (std::abs(refs_[e].points[g].xi - xi) < std::abs(refs_[e].points[best].xi - xi)) best = g;
-  const PlasticBendingHistory* h = &hist_committed_[hist_offset_[e] + best];
-  SectionState s = hermite ? section_state<4, 3>(p, body_.section, x, q, h) : section_state<2, 2>(p, body_.section, x, q, h);
-  const ShapePoint& pg = refs_[e].points[best];
-  const SectionState g =
-      hermite ? section_state<4, 3>(pg, body_.section, x, q, h) : section_state<2, 2>(pg, body_.section, x, q, h);
-  s.M[1] = g.M[1], s.M[2] = g.M[2];
-  s.plastic = *h;
-  s.yielding = yielded_committed_[hist_offset_[e] + best] != 0;
-  const double EI = body_.section.plastic->E * body_.section.plastic->inertia();
-  s.stored_energy_density = 0.5 * (s.Gamma.dot(s.F) + s.Omega[0] * s.M[0] + s.M.tail<2>().squaredNorm() / EI);
+  const PlasticBendingHistory* h = body_.section.plastic ? &hist_committed_[hist_offset_[e] + best] : nullptr;
+  SectionState s = state(refs_[e].points[best], h);
+  s.xi = here.xi;
+  s.position = here.position;
+  s.triad = here.triad;
+  if (body_.section.plastic) {
+    s.yielding = yielded_committed_[hist_offset_[e] + best] != 0;
+    const double EI = body_.section.plastic->E * body_.section.plastic->inertia();
+    s.stored_energy_density = 0.5 * (s.Gamma.dot(s.F) + s.Omega[0] * s.M[0] + s.M.tail<2>().squaredNorm() / EI);
+  }
   return s;
 }
 

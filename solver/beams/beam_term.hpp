@@ -98,12 +98,12 @@ class BeamTerm : public Term {
   /// from the committed history (at the committed u: the committed moment;
   /// `yielding` there is Φ_trial > 0 of that return, see yielded_last_step()).
   std::vector<SectionState> section_states(const Eigen::VectorXd& u, std::size_t e) const;
-  /// Section state at any ξ ∈ [−1, 1] of element e (output sampling).
-  /// Elasto-plastic sections: position, triad, strains, forces and torsion at
-  /// ξ; the bending moment (M₂, M₃), the plastic history and `yielding` are the
-  /// committed ones of the nearest Gauss point (piecewise constant), since the
-  /// plastic state exists only there; `yielding` = that point flowed in the
-  /// last committed step (its Ω̄_pl grew).
+  /// Section state at any ξ ∈ [−1, 1] of element e (output sampling):
+  /// position and triad at ξ; strains, forces, moments (and, for
+  /// elasto-plastic sections, the committed plastic history and `yielding`)
+  /// those of the nearest Gauss point, piecewise constant along the element,
+  /// because resultants are only reliable there and the plastic state exists
+  /// only there; `yielding` = that point flowed in the last committed step.
   SectionState sample(const Eigen::VectorXd& u, std::size_t e, double xi) const;
   /// Stored (elastic) energy of the body at u and the current triads; for
   /// plastic sections from the return of the committed history.
