@@ -14,8 +14,10 @@ namespace stentsim::segmentation {
 
 /// Outer wall made from the lumen alone (issue 3): a tube of circles normal to
 /// the lumen centerline with radius R_ref + t + remodeling·(R_ref − r)₊, never
-/// closer than t/2 to the lumen; R_ref is the centerline's healthy reference
-/// radius, r the local inscribed radius, so the plaque fills the space between.
+/// closer than t/2 to the lumen; R_ref(s) is the healthy reference line of
+/// common/stenosis_site (fitted to the radius's upper envelope: the segments
+/// either side of the stenosis, taper kept), r the local inscribed radius, so
+/// the plaque fills the space between.
 struct WallSynthesisOptions {
   double wall_thickness = 0.5;  // mm, healthy wall
   double remodeling = 0.0;      // outward growth of the outer wall per mm of plaque (0: none, 1: full)

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/error.hpp"
+#include "common/stenosis_site.hpp"
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/polyline_frames.hpp"
 #include "segmentation_io/segmentation_stage.hpp"
@@ -19,7 +20,15 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
   CenterlineResult cl = compute_centerline(lumen, co);
   const auto& pts = cl.centerline.points;
   const auto& r = cl.centerline.point_data.at("MaximumInscribedSphereRadius").values;
+  const auto& S = cl.centerline.point_data.at("Abscissas").values;
   const std::size_t n = pts.size();
+  // Healthy reference radius from the segments either side of the stenosis
+  // (issue 3): the straight line fitted to the radius's upper envelope
+  // (common/stenosis_site, the rule of the ROI and the placement), so a long
+  // stenosis does not pull it down and a tapering vessel keeps its taper.
+  // A whole-segment median would sit inside a stenosis longer than half the segment.
+  const TaperedStenosis site = stenosis_discounting_taper(S, r, S.front() + r.front(), S.back() - r.back());
+  auto reference_at = [&](std::size_t i) { return site.reference_radius + site.slope * (S[i] - site.abscissa); };
   Frames f = parallel_transport_frames(pts);
   // Lumen extent around each centerline point: farthest lumen vertex within a
   // slab normal to the centerline (an eccentric or oval lumen reaches beyond r).
@@ -34,12 +43,14 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
       double along = d.dot(f.tangent[i]);
       if (std::abs(along) > slab) continue;
       double radial = (d - along * f.tangent[i]).norm();
-      if (radial < 4 * cl.reference_radius) extent[i] = std::max(extent[i], radial);
+      if (radial < 4 * reference_at(i)) extent[i] = std::max(extent[i], radial);
     }
-  const double Rref = cl.reference_radius, t = o.wall_thickness;
+  const double Rref = site.reference_radius, t = o.wall_thickness;
   std::vector<double> R(n);
-  for (std::size_t i = 0; i < n; ++i)
-    R[i] = std::max(Rref + t + o.remodeling * std::max(0.0, Rref - r[i]), extent[i] + 0.5 * t);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double ref = reference_at(i);
+    R[i] = std::max(ref + t + o.remodeling * std::max(0.0, ref - r[i]), extent[i] + 0.5 * t);
+  }
   // Smooth over ±1 mm so the outer wall does not copy the lumen's facets.
   std::vector<double> Rs(n);
   const int w = std::max(1, int(std::round(1.0 / co.spacing)));

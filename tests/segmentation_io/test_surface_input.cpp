@@ -308,3 +308,50 @@ TEST(SegmentationStage, SurfaceWithWallAndSynthesizedWallAndPhantom) {
   EXPECT_CONTAINS(error_of([&] { parse_segmentation_input(bin); }), "exactly one of");
   fs::remove_all(d);
 }
+
+// Wall synthesis on a lumen-only phantom (issue 3): the outer wall at the
+// throat sits at R_ref + t (the healthy reference radius from the segments
+// either side of the stenosis, plus the healthy wall thickness: the plaque
+// fills the space between), and with positive remodeling m at
+// R_ref + t + m (R_ref − r_throat) (WallSynthesisOptions). The stenosis is
+// long (14 of 24 mm) so a whole-segment median radius would fall inside it.
+TEST(WallSynthesis, OuterRadiusAtTheThroatFollowsTheReferenceRule) {
+  PhantomSpec spec;
+  spec.curve = PhantomCurve::straight;
+  spec.length = 24.0;
+  spec.reference_radius = 1.5;
+  spec.stenosis_severity = 50.0;
+  spec.stenosis_length = 14.0;
+  spec.eccentricity = 0.0;
+  PhantomGeometry g = build_phantom(spec);
+  TriSurface lumen = surface_from_mesh(g.lumen, "phantom lumen");
+  const double Rref = spec.reference_radius, t = 0.5, r_throat = g.min_radius;
+  ASSERT_NEAR(r_throat, 0.75, 1e-6);
+  // The straight phantom's axis through the throat.
+  const auto& C = g.true_centerline.points;
+  const Eigen::Vector3d axis = (C.back() - C.front()).normalized();
+  auto outer_radius_at_throat = [&](const TriSurface& wall) {
+    double sum = 0;
+    int count = 0;
+    for (const auto& x : wall.points) {
+      const Eigen::Vector3d d = x - g.stenosis_point;
+      const double along = d.dot(axis);
+      if (std::abs(along) > 0.3) continue;
+      sum += (d - along * axis).norm();
+      ++count;
+    }
+    EXPECT_GT(count, 32) << "no wall ring near the throat";
+    return sum / std::max(1, count);
+  };
+  for (double m : {0.0, 1.0}) {
+    SCOPED_TRACE(m);
+    WallSynthesisOptions o;
+    o.wall_thickness = t;
+    o.remodeling = m;
+    const double R = outer_radius_at_throat(synthesize_wall(lumen, o));
+    const double expected = Rref + t + m * (Rref - r_throat);
+    std::printf("remodeling %.1f: outer radius at the throat %.4f mm, expected %.4f mm (%.2f %%)\n", m, R, expected,
+                100 * (R / expected - 1));
+    EXPECT_NEAR(R, expected, 0.05 * expected);
+  }
+}
