@@ -11,6 +11,7 @@
 #include <queue>
 
 #include "common/error.hpp"
+#include "common/stenosis_site.hpp"
 #include "common/log.hpp"
 #include "segmentation_io/medial_axis.hpp"
 #include "segmentation_io/polyline_frames.hpp"
@@ -254,42 +255,35 @@ CenterlineResult compute_centerline(const TriSurface& s, const CenterlineOptions
   cl.field_text["centerline_method"] =
       "Voronoi minimal path (cost 1/R) between the ends, resampled and centred in normal planes";
 
-  // Narrowest site and reference radius, away from the ends.
+  // Stenosis site and reference radius, away from the ends: the narrowest
+  // radius relative to the healthy reference line (common/stenosis_site, the
+  // rule of the segmentation ROI and the device placement), so a tapering
+  // vessel's healthy distal end is not reported as the stenosis.
   res.length = abscissa.back();
-  const double lo = o.end_exclusion_radii * radius.front(), hi = res.length - o.end_exclusion_radii * radius.back();
-  std::vector<double> inner;
-  std::size_t imin = n / 2;
-  double rmin = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (abscissa[i] < lo || abscissa[i] > hi) continue;
-    inner.push_back(radius[i]);
-    if (radius[i] < rmin) rmin = radius[i], imin = i;
-  }
-  if (inner.empty()) {
-    for (std::size_t i = 0; i < n; ++i) inner.push_back(radius[i]);
-    imin = std::size_t(std::min_element(radius.begin(), radius.end()) - radius.begin());
-  }
-  // Parabola through the minimum and its neighbours for a sub-sample site.
+  double lo = o.end_exclusion_radii * radius.front(), hi = res.length - o.end_exclusion_radii * radius.back();
+  if (std::count_if(abscissa.begin(), abscissa.end(), [&](double s) { return s >= lo && s <= hi; }) < 3)
+    lo = 0, hi = res.length;  // a segment shorter than its end exclusions: use every sample
+  const TaperedStenosis site = stenosis_discounting_taper(abscissa, radius, lo, hi);
+  auto ref_at = [&](double s) { return site.reference_radius + site.slope * (s - site.abscissa); };
+  std::size_t imin = std::size_t(std::find(abscissa.begin(), abscissa.end(), site.abscissa) - abscissa.begin());
+  // Parabola through the smallest ratio r / r_ref and its neighbours for a sub-sample site.
   res.stenosis_abscissa = abscissa[imin];
   res.min_radius = radius[imin];
   res.stenosis_point = pts[imin];
   if (imin > 0 && imin + 1 < n) {
-    double y0 = radius[imin - 1], y1 = radius[imin], y2 = radius[imin + 1];
+    double y0 = radius[imin - 1] / ref_at(abscissa[imin - 1]), y1 = radius[imin] / ref_at(abscissa[imin]),
+           y2 = radius[imin + 1] / ref_at(abscissa[imin + 1]);
     double den = y0 - 2 * y1 + y2;
     if (den > 0) {
       double x = std::clamp(0.5 * (y0 - y2) / den, -1.0, 1.0);
-      res.min_radius = y1 - 0.25 * (y0 - y2) * x;
       double hs = x >= 0 ? abscissa[imin + 1] - abscissa[imin] : abscissa[imin] - abscissa[imin - 1];
       res.stenosis_abscissa = abscissa[imin] + x * hs;
+      res.min_radius = (y1 - 0.25 * (y0 - y2) * x) * ref_at(res.stenosis_abscissa);
       res.stenosis_point = pts[imin] + x * (x >= 0 ? pts[imin + 1] - pts[imin] : pts[imin] - pts[imin - 1]);
     }
   }
-  if (o.reference_radius) {
-    res.reference_radius = *o.reference_radius;
-  } else {
-    std::nth_element(inner.begin(), inner.begin() + inner.size() / 2, inner.end());
-    res.reference_radius = inner[inner.size() / 2];
-  }
+  res.reference_radius = o.reference_radius ? *o.reference_radius : ref_at(res.stenosis_abscissa);
+  res.reference_taper = site.slope;
   res.stenosis_percent_diameter = 100 * (1 - res.min_radius / res.reference_radius);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;

@@ -34,7 +34,7 @@ struct CenterlineOptions {
   std::optional<Eigen::Vector3d> source_point, target_point;
   int centering_passes = 2;
   /// Healthy reference radius for the % diameter stenosis; default: the
-  /// median inscribed radius away from the ends.
+  /// taper line of common/stenosis_site at the stenosis site.
   std::optional<double> reference_radius;
   /// The narrowest site and the reference are searched this many local radii
   /// away from the ends.
@@ -51,10 +51,13 @@ CenterlineOptions parse_centerline_options(ConfigMap& section);
 struct CenterlineResult {
   MeshData centerline;  // one polyline with the point arrays listed above
   double length = 0;                  // mm
-  double min_radius = 0;              // mm, at the narrowest site
-  double stenosis_abscissa = 0;       // mm, narrowest site along the centerline
+  // The stenosis discounts the taper (common/stenosis_site): the site is the
+  // smallest r / r_ref(s), r_ref a straight line fitted to the radius's upper envelope.
+  double min_radius = 0;              // mm, lumen radius at the stenosis site
+  double stenosis_abscissa = 0;       // mm, stenosis site along the centerline
   Eigen::Vector3d stenosis_point = Eigen::Vector3d::Zero();
-  double reference_radius = 0;        // mm
+  double reference_radius = 0;        // mm, r_ref at the site (or CenterlineOptions::reference_radius)
+  double reference_taper = 0;         // dr_ref/ds of the fitted reference line
   double stenosis_percent_diameter = 0;  // 100 (1 − r_min / r_ref)
   std::size_t voronoi_nodes = 0;
   double seconds = 0;                 // wall time of compute_centerline

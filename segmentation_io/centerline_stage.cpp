@@ -45,13 +45,17 @@ void run_centerline_stage(const CenterlineOptions& options, const std::filesyste
   summary.set("stenosis_point", std::vector<double>{r.stenosis_point.x(), r.stenosis_point.y(), r.stenosis_point.z()}, "mm");
   summary.set("reference_radius", r.reference_radius, "mm");
   summary.set("stenosis_percent_diameter", r.stenosis_percent_diameter, "%");
+  summary.set("reference_taper", r.reference_taper);  // dr_ref/ds
   summary.set("voronoi_nodes", double(r.voronoi_nodes));
   summary.set("lumen_triangles", double(lumen.num_cells()));
   summary.set("centerline_time_s", r.seconds, "s");
   summary.note("reference_radius", options.reference_radius ? "given in the case"
-                                                            : "median inscribed radius away from the ends");
+                                                            : "straight line fitted to the inscribed radius's upper "
+                                                              "envelope away from the ends, at the stenosis site");
+  summary.note("stenosis_rule", "smallest radius relative to the reference line (discounts the vessel taper; "
+                                "common/stenosis_site, as the ROI and the placement)");
   summary.note("centerline_method", r.centerline.field_text["centerline_method"]);
-  log::info("centerline: {:.2f} mm, narrowest radius {:.4f} mm at {:.2f} mm ({:.1f} % diameter stenosis), {:.2f} s",
+  log::info("centerline: {:.2f} mm, stenosis radius {:.4f} mm at {:.2f} mm ({:.1f} % diameter stenosis), {:.2f} s",
             r.length, r.min_radius, r.stenosis_abscissa, r.stenosis_percent_diameter, r.seconds);
   if (options.true_centerline) {
     MeshData truth = read_vtp(options.true_centerline->string());

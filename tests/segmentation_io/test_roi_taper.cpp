@@ -105,3 +105,25 @@ TEST(RoiTaper, RegionOfInterestIsCentredOnTheStenosisNotTheDistalEnd) {
   EXPECT_NEAR(zmin, s0, 1e-6);
   EXPECT_NEAR(zmax, s1, 1e-6);
 }
+
+namespace {
+
+// The centerline stage reports the same taper-discounted stenosis (issue 3:
+// the narrowest site, % diameter against the reference): on the tapering tube
+// the raw minimum is the distal end, the reported site the 30 % dip at 6 mm.
+TEST(CenterlineStenosis, TaperingTubeReportsTheDipNotTheDistalEnd) {
+  CenterlineResult r = compute_centerline(tapered_tube(200, 64), CenterlineOptions{});
+  // The polygonal section's inscribed radius is cos(pi/64) of the vertex radius.
+  const double c = std::cos(M_PI / 64);
+  std::printf("site %.3f mm (true 6), radius %.4f (true %.4f), reference %.4f (true %.4f), taper %.4f (true -0.06), "
+              "%%DS %.2f (true 30)\n",
+              r.stenosis_abscissa, r.min_radius, c * lumen_radius(6.0), r.reference_radius, c * healthy(6.0),
+              r.reference_taper, r.stenosis_percent_diameter);
+  EXPECT_NEAR(r.stenosis_abscissa, 6.0, 0.5);
+  EXPECT_NEAR(r.min_radius, c * lumen_radius(6.0), 0.03 * lumen_radius(6.0));
+  EXPECT_NEAR(r.reference_radius, c * healthy(6.0), 0.03 * healthy(6.0));
+  EXPECT_NEAR(r.reference_taper, -0.06, 0.01);
+  EXPECT_NEAR(r.stenosis_percent_diameter, 30.0, 2.0);
+}
+
+}  // namespace
