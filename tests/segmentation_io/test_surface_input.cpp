@@ -352,6 +352,7 @@ TEST(WallSynthesis, OuterRadiusAtTheThroatFollowsTheReferenceRule) {
     const double expected = Rref + t + m * (Rref - r_throat);
     std::printf("remodeling %.1f: outer radius at the throat %.4f mm, expected %.4f mm (%.2f %%)\n", m, R, expected,
                 100 * (R / expected - 1));
-    EXPECT_NEAR(R, expected, 0.05 * expected);
+    // 2 %: the rule is met to 0.2 % / 0.8 %; the old whole-centerline median missed by 5.3 % / 8.2 %.
+    EXPECT_NEAR(R, expected, 0.02 * expected);
   }
 }
