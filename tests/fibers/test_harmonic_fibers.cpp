@@ -214,12 +214,22 @@ TEST(HarmonicFibers, CliWritesFibersAndSummaryAndRejectsMeshWithoutFaceGroups) {
   write_vtp((dir / "centerline.vtp").string(), straight_centerline());
   const auto r = stentsim::testing::run_stentsim("fibers --mesh " + (dir / "artery.vtu").string() + " --centerline " +
                                        (dir / "centerline.vtp").string() + " --out " + (dir / "out/fibers.vtu").string() +
-                                       " --adventitia-angle 40 --linear-solver direct");
+                                       " --adventitia-angle 40 --linear-solver direct --quadratic-laplace");
   ASSERT_EQ(r.code, 0) << r.out;
   ASSERT_TRUE(fs::exists(dir / "out/summary.yaml"));
   const MeshData f = read_vtu((dir / "out/fibers.vtu").string());
   const auto e = compare_with_analytic(mesh, f);
-  EXPECT_LT(e.mean, 0.5);
+  EXPECT_LT(e.mean, 0.5);  // issue 5's bound, met by the quadratic solve
+  // The default for tet10 solves on the corner nodes (tet4 accuracy, seconds at patient size): on this coarse
+  // tube (4 elements through the wall) it is measurably less accurate; bounded here so a regression shows.
+  const auto rc = stentsim::testing::run_stentsim("fibers --mesh " + (dir / "artery.vtu").string() + " --centerline " +
+                                        (dir / "centerline.vtp").string() + " --out " +
+                                        (dir / "corners/fibers.vtu").string() + " --linear-solver direct");
+  ASSERT_EQ(rc.code, 0) << rc.out;
+  const auto ec = compare_with_analytic(mesh, read_vtu((dir / "corners/fibers.vtu").string()));
+  std::printf("CLI fibers on the tet10 tube: quadratic mean %.3f max %.3f deg; corner solve mean %.3f max %.3f deg\n",
+              e.mean, e.max, ec.mean, ec.max);
+  EXPECT_LT(ec.mean, 1.0);
   EXPECT_TRUE(f.point_data.count("Transmural"));
   EXPECT_TRUE(f.cell_data.count("Transmural"));
 

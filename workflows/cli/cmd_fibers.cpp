@@ -18,6 +18,7 @@ void register_fibers(CLI::App& app) {
   struct Args {
     std::string mesh, centerline, out, solver = fibers::HarmonicFiberOptions{}.linear_solver;
     double intima = 0, media = 0, adventitia = 40, weight = 0.5;  // deg from circumferential (paper 4.2)
+    bool quadratic = false;
   };
   auto a = std::make_shared<Args>();
   auto* sub = app.add_subcommand("fibers", "Fiber field of a wall mesh by harmonic lifting: fibers.vtu");
@@ -30,12 +31,16 @@ void register_fibers(CLI::App& app) {
   sub->add_option("--centerline-weight", a->weight, "Weight of the centerline tangent vs grad of the longitudinal coordinate (0..1)")
       ->capture_default_str();
   sub->add_option("--linear-solver", a->solver, "gmres_ilu | gmres_amg | direct | eigen_lu")->capture_default_str();
+  sub->add_flag("--quadratic-laplace", a->quadratic,
+                "tet10: solve the Laplace problems on all 10 nodes (more accurate, minutes at patient size) "
+                "instead of on the corner nodes");
   on(sub, [a] {
     fibers::HarmonicFiberOptions o;
     const double rad = M_PI / 180.0;
     o.angles = {{tags::intima, a->intima * rad}, {tags::media, a->media * rad}, {tags::adventitia, a->adventitia * rad}};
     o.centerline_weight = a->weight;
     o.linear_solver = a->solver;
+    if (a->quadratic) o.linear_on_corners = false;
     Summary s;
     fibers::write_harmonic_fibers(a->mesh, a->centerline, o, a->out, s);
     const fs::path out(a->out);
