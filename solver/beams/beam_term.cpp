@@ -1,10 +1,12 @@
 #include "solver/beams/beam_term.hpp"
+#include "solver/beams/rigid_joints.hpp"
 
 #include "common/error.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 #include <cmath>
+#include <numeric>
+#include <stdexcept>
 #include <utility>
 
 namespace stentsim::solver::beams {
@@ -43,20 +45,11 @@ long long beam_nodal_dof_count(const BeamBodyDefinition& body) {
 }
 
 std::vector<BeamNodeDofs> number_beam_dofs(const BeamBodyDefinition& body, GlobalDof first, GlobalDof* next) {
-  const std::vector<bool> end = beam_end_nodes(body);
-  std::vector<BeamNodeDofs> dofs(body.nodes.size());
-  GlobalDof k = first;
-  const bool hermite = body.interpolation == BeamInterpolation::hermite3;
-  for (std::size_t n = 0; n < dofs.size(); ++n) {
-    if (end[n])
-      for (int i = 0; i < 3; ++i) dofs[n].pos[i] = k++;
-    if (end[n] || hermite)
-      for (int i = 0; i < 3; ++i) dofs[n].rot[i] = k++;
-    if (end[n] && hermite)
-      for (int i = 0; i < 3; ++i) dofs[n].tan[i] = k++;
-  }
-  if (next) *next = k;
-  return dofs;
+  // Without joints every node is its own master: one numbering rule (rigid_joints.cpp).
+  JointMap none;
+  none.master.resize(body.nodes.size());
+  std::iota(none.master.begin(), none.master.end(), 0);
+  return number_joined_beam_dofs(body, none, first, next);
 }
 
 BeamTerm::BeamTerm(std::string name, BeamBodyDefinition body, std::vector<BeamNodeDofs> dofs)
