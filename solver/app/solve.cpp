@@ -606,6 +606,9 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   } catch (const ComputeError& e) {
     failure = e.what();
     status = 2;
+    // The stalled step's failed attempts are in no step record; the totals count every attempt (issue 11).
+    if (const auto* stall = dynamic_cast<const LoadStepStall*>(&e))
+      newton_total += stall->newton_iterations, linear_total += stall->linear_iterations, cuts_total += stall->cuts;
     log::error("{}", failure);
     if (std::abs(writer.last_time() - t_last) > 1e-12) frame(t_last);  // the last converged state
     log::error("the last converged state (t = {:.6g}) is in {}", t_last, (out_dir / "results.pvd").string());
@@ -645,7 +648,13 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   summary.note("scene", scene_yaml.string());
   summary.note("linear_solver", linear->describe());
   for (std::size_t i = 0; i < built->notes.size(); ++i) summary.note(fmt::format("material_{}", i), built->notes[i]);
-  summary.set_run(std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), peak_memory_mb_self());
+  // Every rank's own peak memory, gathered on rank 0 (issue 11: a study sums them over ranks);
+  // the run's peak_memory_mb is that sum.
+  Eigen::VectorXd rank_memory = Eigen::VectorXd::Zero(model.ranks);
+  rank_memory[model.rank] = peak_memory_mb_self();
+  parallel::sum(rank_memory);
+  summary.set("peak_memory_mb_per_rank", std::vector<double>(rank_memory.data(), rank_memory.data() + rank_memory.size()), "MB");
+  summary.set_run(std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), rank_memory.sum());
   if (writes) summary.write(out_dir / "summary.yaml");
   else std::filesystem::remove_all(std::filesystem::temp_directory_path() / fmt::format("stentsim_rank{}_{}", model.rank, ::getpid()));
   log::info("solve {}: {} steps, {} Newton iterations; results in {}", status == 0 ? "completed" : "FAILED", steps, newton_total,

@@ -57,10 +57,14 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
                           s.max_consecutive_cuts);
       if (!why.empty()) {
         const std::string load = s.describe_load ? s.describe_load(t) : fmt::format("t = {:.6g}", t);
-        throw LoadStepStall(fmt::format("no converged state beyond {}: the step of size {:.3g} to t = {:.6g} failed "
+        LoadStepStall stall(fmt::format("no converged state beyond {}: the step of size {:.3g} to t = {:.6g} failed "
                                         "and {}; last reason: {}",
                                         load, h, t + h, why, nr.failure),
                             t, h);
+        stall.newton_iterations = rec.newton_iterations;
+        stall.linear_iterations = rec.linear_iterations;
+        stall.cuts = cuts;
+        throw stall;
       }
       log::warn("step at t = {:.6g} (dt = {:.3g}) failed: {}; cutting to dt = {:.3g}", t + h, h, nr.failure, dt);
     }

@@ -45,12 +45,15 @@ class LoadStepStall : public ComputeError {
   LoadStepStall(const std::string& what, double time, double dt) : ComputeError(what), time(time), dt(dt) {}
   double time;  // last converged pseudo-time
   double dt;    // the step size that failed last
+  // The stalled step's failed attempts, which no StepRecord reports: a run's
+  // totals (summary.yaml, issue 11's stability table) add these.
+  int newton_iterations = 0, linear_iterations = 0, cuts = 0;
 };
 
 struct StepRecord {
   int step = 0;
   double time = 0.0, dt = 0.0;
-  int newton_iterations = 0, linear_iterations = 0, cuts = 0;
+  int newton_iterations = 0, linear_iterations = 0, cuts = 0;  // every attempt of the step, the cut ones included
   double wall_seconds = 0.0, assembly_seconds = 0.0, linear_seconds = 0.0;
   double next_dt = 0.0;        // the step size the stepper tries next (restart resumes with it)
   std::vector<double> residual_norms;
