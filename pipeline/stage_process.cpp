@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,6 +14,7 @@
 #include "common/error.hpp"
 #include "common/log.hpp"
 #include "common/summary.hpp"
+#include "pipeline/child_process.hpp"
 
 namespace stentsim::pipeline {
 namespace {
@@ -35,39 +35,37 @@ StageChild start_stage(const Stage& stage, const std::filesystem::path& work_dir
                        const std::filesystem::path& log_file) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw ComputeError(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
-  std::fflush(nullptr);
-  pid_t pid = ::fork();
-  if (pid < 0) throw ComputeError(fmt::format("cannot start stage '{}': fork failed: {}", stage.name, std::strerror(errno)));
-  if (pid == 0) {
+  pid_t pid = -1;
+  try {
+    // Its own process group (the runner stops the stage and anything it
+    // started, mpirun or gmsh, together) and it dies with the runner, so no
+    // orphan keeps the work-folder lock: pipeline/child_process.hpp.
+    pid = spawn([&]() -> int {
+      ::close(fds[0]);
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        log::set_file(log_file);
+        log::set_prefix(stage.name);
+        log::debug("---- stage {} started (pid {}) ----", stage.name, ::getpid());
+        StageContext ctx(stage, work_dir, temp_dir);
+        stage.run(ctx);
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        ctx.summary().set_run(wall, peak_memory_mb_self());
+        ctx.summary().write(ctx.output(summary_output(stage.name)));
+        log::info("finished in {:.2f} s", wall);
+        child_exit(fds[1], 0, "");
+      } catch (const std::exception& e) {
+        log::error("{}", e.what());
+        child_exit(fds[1], 1, e.what());
+      } catch (...) {
+        child_exit(fds[1], 1, "unknown error");
+      }
+    });
+  } catch (const ComputeError& e) {
     ::close(fds[0]);
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGTERM, SIG_DFL);
-    // Its own process group, so the runner can stop the stage and anything it
-    // started (mpirun, gmsh) together; and it dies when the runner is killed,
-    // so no orphan keeps the work-folder lock.
-    ::setpgid(0, 0);
-    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (::getppid() == 1) ::_exit(1);
-    const auto start = std::chrono::steady_clock::now();
-    try {
-      log::set_file(log_file);
-      log::set_prefix(stage.name);
-      log::debug("---- stage {} started (pid {}) ----", stage.name, ::getpid());
-      StageContext ctx(stage, work_dir, temp_dir);
-      stage.run(ctx);
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      ctx.summary().set_run(wall, peak_memory_mb_self());
-      ctx.summary().write(ctx.output(summary_output(stage.name)));
-      log::info("finished in {:.2f} s", wall);
-      child_exit(fds[1], 0, "");
-    } catch (const std::exception& e) {
-      log::error("{}", e.what());
-      child_exit(fds[1], 1, e.what());
-    } catch (...) {
-      child_exit(fds[1], 1, "unknown error");
-    }
+    ::close(fds[1]);
+    throw ComputeError(fmt::format("cannot start stage '{}': {}", stage.name, e.what()));
   }
-  ::setpgid(pid, pid);  // also here: no race with a stop signal sent right after fork
   ::close(fds[1]);
   return {pid, fds[0]};
 }

@@ -1,7 +1,9 @@
 // Error study (issue 11): Richardson/GCI and fitted orders on synthetic data,
 // study-file validation, the analytic references of the shipped scenes, and
 // the runner on a cheap command (phantom segmentation, ~0.5 s a run):
-// caching, core limit, CSV columns, plots, --dry-run / --yes.
+// caching, core limit, CSV columns, plots, --dry-run / --yes; file names in
+// the base resolved against their origin; peak memory of MPI runs summed over
+// ranks (a 2-rank solve of a small tube).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +16,7 @@
 #include "workflows/study/analytic_references.hpp"
 #include "workflows/study/convergence.hpp"
 #include "workflows/study/error_study.hpp"
+#include "workflows/study/input_paths.hpp"
 #include "workflows/study/study_config.hpp"
 
 namespace fs = std::filesystem;
@@ -252,5 +255,131 @@ TEST(StudyCli, DryRunListsRunsAndManyRunsNeedYes) {
   EXPECT_FALSE(fs::exists(d / "out" / "runs"));
   const auto bad = stentsim::testing::run_stentsim("study error " + (d / "nothing.yaml").string());
   EXPECT_EQ(bad.code, 2) << bad.out;
+  fs::remove_all(d);
+}
+
+TEST(StudyConfigFile, RelativeFilesResolveAgainstTheirOrigin) {
+  // The base names its mesh relative to itself; a knob value names a file
+  // relative to the study file; words that are no file stay words.
+  const fs::path d = fresh_dir("paths");
+  fs::create_directories(d / "cases");
+  fs::create_directories(d / "meshes");
+  write(d / "cases" / "mesh.vtu", "coarse");
+  write(d / "meshes" / "fine.vtu", "fine");
+  write(d / "cases" / "scene.yaml", "bodies:\n  - mesh: {file: mesh.vtu, element: tet10}\n");
+  write(d / "study.yaml", "base: cases/scene.yaml\nqoi: x\nreference: {type: value, value: 1}\n"
+                          "knobs: [{name: m, key: bodies.0.mesh.file, values: [meshes/fine.vtu, cases/mesh.vtu]}]\n");
+  const StudyConfig s = load_study(d / "study.yaml");
+  EXPECT_EQ(fs::path(s.base["bodies"][0]["mesh"]["file"].as<std::string>()), fs::absolute(d / "cases" / "mesh.vtu").lexically_normal());
+  EXPECT_EQ(s.base["bodies"][0]["mesh"]["element"].as<std::string>(), "tet10");
+  EXPECT_EQ(fs::path(s.knobs[0].values[0][0].as<std::string>()), fs::absolute(d / "meshes" / "fine.vtu").lexically_normal());
+  // The second knob value is the base's own mesh, named from the study's folder: the same run.
+  const StudyPlan p = plan_study(s);
+  EXPECT_EQ(p.runs.size(), 2u);
+  // A run reads the file: changed content is a new run (new key).
+  const std::string key = p.runs[0].key;
+  write(d / "cases" / "mesh.vtu", "coarse, edited");
+  EXPECT_NE(plan_study(load_study(d / "study.yaml")).runs[0].key, key);
+  fs::remove_all(d);
+}
+
+TEST(StudyRunner, BaseNamingItsMeshRelativeToItselfRuns) {
+  // The shipped contrast bar names contrast_bar.vtu beside itself; the study
+  // sits one folder up and runs the copy in OUT/runs/<key>/.
+  const fs::path src = fs::path(STENTSIM_TEST_SOURCE_DIR) / "examples" / "studies" / "stability";
+  const fs::path d = fresh_dir("relmesh");
+  fs::create_directories(d / "cases");
+  for (const char* f : {"contrast_bar.yaml", "contrast_bar.vtu"}) fs::copy_file(src / f, d / "cases" / f);
+  write(d / "study.yaml", "base: cases/contrast_bar.yaml\nqoi: max_displacement\nreference: {type: value, value: 0.3}\n"
+                          "knobs: [{name: dt, key: solver.time.dt, values: [0.25]}]\n");
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out";
+  std::ostringstream log;
+  ErrorStudyResult r;
+  EXPECT_EQ(run_error_study(d / "study.yaml", o, log, &r), 0) << log.str();
+  ASSERT_EQ(r.results.size(), 1u);
+  EXPECT_EQ(r.results[0].status, "ok") << r.results[0].message;
+  // The pulled end moved 0.3 mm along the bar; the largest displacement adds
+  // the soft half's lateral contraction (0.3037 mm measured).
+  EXPECT_GE(r.outcome.value[0], 0.3 - 1e-9);
+  EXPECT_LT(r.outcome.value[0], 0.31);
+  fs::remove_all(d);
+}
+
+TEST(StudyRunner, RankMemoryIsSummedWhenReported) {
+  RunResult r;
+  r.peak_memory_mb = 130;  // wait4: the largest process of mpirun's tree
+  r.qoi[kPerRankMemoryQoi] = {100, 120};
+  apply_rank_memory(r, 2);
+  EXPECT_DOUBLE_EQ(r.peak_memory_mb, 220);
+  EXPECT_EQ(r.peak_memory_rule, "sum over 2 ranks");
+  RunResult unreported;
+  unreported.peak_memory_mb = 130;
+  apply_rank_memory(unreported, 2);
+  EXPECT_DOUBLE_EQ(unreported.peak_memory_mb, 130);
+  EXPECT_NE(unreported.peak_memory_rule.find("largest"), std::string::npos);
+  RunResult one;
+  one.peak_memory_mb = 50;
+  one.qoi[kPerRankMemoryQoi] = {48};
+  apply_rank_memory(one, 1);
+  EXPECT_DOUBLE_EQ(one.peak_memory_mb, 50);  // one process: wait4's value
+}
+
+TEST(StudyRunner, MpiRunReportsMemorySummedOverRanks) {
+  // A small tube solved on 1 and 2 ranks: each rank writes its own peak into
+  // summary.yaml and the 2-rank row is their sum.
+  const fs::path d = fresh_dir("mpi");
+  write(d / "study.yaml", "base: " + (fs::path(STENTSIM_TEST_SOURCE_DIR) / "examples/tube_inflation.yaml").string() +
+                              "\noverrides: {bodies.0.mesh.generate.radial: 2, bodies.0.mesh.generate.circumferential: 6}\n"
+                              "qoi: inner_radius_at_pmax\nreference: {type: tube_plane_strain}\n"
+                              "knobs: [{name: ranks, key: \"@ranks\", values: [2]}]\n");
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out";
+  o.cores = 2;
+  std::ostringstream log;
+  ErrorStudyResult r;
+  ASSERT_EQ(run_error_study(d / "study.yaml", o, log, &r), 0) << log.str();
+  ASSERT_EQ(r.plan.runs.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const RunResult& res = r.results[i];
+    const int ranks = r.plan.runs[i].ranks;
+    ASSERT_EQ(res.status, "ok") << res.message;
+    ASSERT_TRUE(res.qoi.count(kPerRankMemoryQoi)) << "summary.yaml has no per-rank memory";
+    const auto& per_rank = res.qoi.at(kPerRankMemoryQoi);
+    ASSERT_EQ(static_cast<int>(per_rank.size()), ranks);
+    double sum = 0;
+    for (double m : per_rank) {
+      EXPECT_GT(m, 5) << "a rank's peak memory in MB";
+      sum += m;
+    }
+    if (ranks == 1) {
+      EXPECT_EQ(res.peak_memory_rule, "wait4");
+    } else {
+      EXPECT_EQ(res.peak_memory_rule, "sum over 2 ranks");
+      EXPECT_GE(res.peak_memory_mb, sum - 1e-9);
+      EXPECT_GT(res.peak_memory_mb, 1.5 * std::max(per_rank[0], per_rank[1]));  // not the largest process alone
+    }
+  }
+  // Both solves agree (the 2-rank partition sums the same residual).
+  EXPECT_NEAR(r.outcome.value[0], r.outcome.value[1], 1e-9);
+  EXPECT_NE(read(o.out_dir / "study.csv").find("sum over 2 ranks"), std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST(StudyCli, DryRunEstimatesFromBaseTimeBeforeAnythingRan) {
+  // h knob with cost exponent 2: h 0.2 costs 4x the base's (h 0.4 by the base's own setting: 32 points).
+  const fs::path d = fresh_dir("estimate");
+  phantom_study(d, "[16, 64]", "    h: [0.4, 0.2]\n    cost_exponent: 2\n");
+  const auto none = stentsim::testing::run_stentsim("study error " + (d / "study.yaml").string() + " --dry-run --out " + (d / "out").string());
+  EXPECT_EQ(none.code, 0) << none.out;
+  EXPECT_NE(none.out.find("give base_time"), std::string::npos) << none.out;
+  std::ofstream(d / "study.yaml", std::ios::app) << "base_time: 2 s\n";
+  const auto est = stentsim::testing::run_stentsim("study error " + (d / "study.yaml").string() + " --dry-run --out " + (d / "out").string());
+  EXPECT_EQ(est.code, 0) << est.out;
+  // base 2 s; points=16 (h 0.4) nearest the base (one knob differs, the base has no h): 2 s; points=64 likewise.
+  EXPECT_NE(est.out.find("~2.0 s"), std::string::npos) << est.out;
+  EXPECT_NE(est.out.find("estimated time to run: 6 s (from the study's base_time 2 s)"), std::string::npos) << est.out;
   fs::remove_all(d);
 }

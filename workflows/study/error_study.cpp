@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <ostream>
@@ -60,13 +61,17 @@ int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostre
       measured[i] = any->wall_s;  // another host or binary: a fair estimate, still re-run
     }
   }
+  // Nothing measured yet: the study file's recorded base time stands in for the base run.
+  const bool nothing_measured = std::none_of(measured.begin(), measured.end(), [](const auto& m) { return m.has_value(); });
+  std::vector<std::optional<double>> estimates_from = measured;
+  if (nothing_measured && study.base_time_s) estimates_from[0] = *study.base_time_s;  // runs[0] is the base
   if (o.dry_run) {
     out << fmt::format("study {}: {} runs ({} cached, {} to run) in {}\n", study.name, n, cached, n - cached, r.out_dir.string());
     double total = 0;
     bool unknown = false;
     for (std::size_t i = 0; i < n; ++i) {
       const bool is_cached = cached_result(run_dir(r.out_dir, r.plan.runs[i]), host, o.reuse_timings).has_value();
-      const double est = estimate_seconds(study, r.plan, i, measured);
+      const double est = estimate_seconds(study, r.plan, i, estimates_from);
       if (!is_cached) {
         if (est >= 0) total += est;
         else unknown = true;
@@ -74,8 +79,11 @@ int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostre
       out << fmt::format("  {} {:<50} ranks {}  {}\n", r.plan.runs[i].key.substr(0, 8), r.plan.runs[i].label, r.plan.runs[i].ranks,
                          is_cached ? "cached" : est >= 0 ? fmt::format("~{:.1f} s", est) : "unknown (nothing measured yet)");
     }
-    out << fmt::format("estimated time to run: {:.0f} s{}\n", total, unknown ? " + runs without an estimate" : "");
-    if (n > kMaxRunsWithoutYes) out << fmt::format("more than {} runs: the real run needs --yes\n", kMaxRunsWithoutYes);
+    out << fmt::format("estimated time to run: {:.0f} s{}{}\n", total, unknown ? " + runs without an estimate" : "",
+                       nothing_measured && study.base_time_s ? fmt::format(" (from the study's base_time {:.3g} s)", *study.base_time_s)
+                       : nothing_measured ? " (nothing measured yet: give base_time in the study file for an estimate)"
+                                          : "");
+    if (n - cached > kMaxRunsWithoutYes) out << fmt::format("more than {} runs to do: the real run needs --yes\n", kMaxRunsWithoutYes);
     return 0;
   }
   if (n - cached > kMaxRunsWithoutYes && !o.yes)

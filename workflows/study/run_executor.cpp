@@ -1,10 +1,7 @@
 #include "workflows/study/run_executor.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
-#include <sys/prctl.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -21,6 +18,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/summary.hpp"
+#include "pipeline/child_process.hpp"
 #include "workflows/version.hpp"
 
 namespace fs = std::filesystem;
@@ -43,34 +41,12 @@ std::string tail_lines(const fs::path& file, std::size_t n) {
 }
 
 pid_t start_child(const std::vector<std::string>& args, const fs::path& log) {
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) throw ComputeError(fmt::format("study: fork failed: {}", std::strerror(errno)));
-  if (pid == 0) {
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGTERM, SIG_DFL);
-    ::setpgid(0, 0);  // the study stops a run and all it started (mpirun ranks) together
-    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    if (fd >= 0) {
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      ::close(fd);
-    }
-    // One thread per rank: the core budget counts ranks.
-    ::setenv("OMP_NUM_THREADS", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    std::vector<std::string> copy = args;
-    std::vector<char*> argv;
-    for (auto& s : copy) argv.push_back(s.data());
-    argv.push_back(nullptr);
-    ::execvp(argv[0], argv.data());
-    std::fprintf(stderr, "study: cannot execute %s: %s\n", argv[0], std::strerror(errno));
-    ::_exit(127);
-  }
-  ::setpgid(pid, pid);
-  return pid;
+  pipeline::ChildSetup setup;
+  setup.log = log;
+  setup.append_log = true;  // the run's commands share run.log
+  // One thread per rank: the core budget counts ranks.
+  setup.env = {{"OMP_NUM_THREADS", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"}};
+  return pipeline::spawn_exec(args, setup);
 }
 
 void write_result(const fs::path& file, const RunResult& r) {
@@ -81,6 +57,7 @@ void write_result(const fs::path& file, const RunResult& r) {
   e << YAML::Key << "wall_time_s" << YAML::Value << r.wall_s;
   e << YAML::Key << "cpu_time_s" << YAML::Value << r.cpu_s;
   e << YAML::Key << "peak_memory_mb" << YAML::Value << r.peak_memory_mb;
+  e << YAML::Key << "peak_memory_rule" << YAML::Value << r.peak_memory_rule;
   e << YAML::Key << "host" << YAML::Value << r.host;
   e << YAML::Key << "nproc" << YAML::Value << r.nproc;
   e << YAML::Key << "load_average" << YAML::Value << r.load_average;
@@ -109,6 +86,21 @@ void read_qois(const fs::path& summary, RunResult& r) {
 
 }  // namespace
 
+void apply_rank_memory(RunResult& r, int ranks) {
+  if (ranks <= 1) return;  // one process: wait4's peak is the run's
+  const auto it = r.qoi.find(kPerRankMemoryQoi);
+  if (it == r.qoi.end() || static_cast<int>(it->second.size()) != ranks) {
+    r.peak_memory_rule = fmt::format("wait4: largest of {} ranks (the command reports no {})", ranks, kPerRankMemoryQoi);
+    return;
+  }
+  double sum = 0;
+  for (double m : it->second) sum += m;
+  // The ranks' peaks need not coincide in time: the sum is an upper bound of
+  // the run's peak, and what the run needs of a machine's memory.
+  r.peak_memory_mb = std::max(r.peak_memory_mb, sum);
+  r.peak_memory_rule = fmt::format("sum over {} ranks", ranks);
+}
+
 fs::path run_dir(const fs::path& out_dir, const RunSpec& run) { return out_dir / "runs" / run.key; }
 
 HostInfo this_host(const std::string& binary) {
@@ -134,6 +126,7 @@ std::optional<RunResult> cached_result(const fs::path& dir, const HostInfo& host
     r.wall_s = n["wall_time_s"].as<double>();
     r.cpu_s = n["cpu_time_s"].as<double>();
     r.peak_memory_mb = n["peak_memory_mb"].as<double>();
+    r.peak_memory_rule = n["peak_memory_rule"].as<std::string>("wait4");
     r.host = n["host"].as<std::string>();
     r.nproc = n["nproc"].as<int>();
     r.load_average = n["load_average"].as<double>();
@@ -201,6 +194,7 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
     res.peak_memory_mb = r.peak;
     res.status = ok ? "ok" : "failed";
     res.message = why;
+    res.peak_memory_rule = "wait4";
     if (ok) {
       try {
         read_qois(dir / "summary.yaml", res);
@@ -208,6 +202,7 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
         res.status = "failed";
         res.message = fmt::format("no readable summary.yaml: {}", e.what());
       }
+      apply_rank_memory(res, spec.ranks);
     }
     write_result(dir / "result.yaml", res);
     ++stats.executed;
@@ -247,21 +242,18 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
         running.emplace(pid, std::move(r));
       }
       if (running.empty()) continue;
-      int status = 0;
-      struct rusage ru {};
-      const pid_t pid = ::wait4(-1, &status, 0, &ru);
-      if (pid < 0) {
-        if (errno == EINTR) continue;
-        throw ComputeError(fmt::format("study: wait4 failed: {}", std::strerror(errno)));
-      }
-      auto it = running.find(pid);
+      const auto reaped = pipeline::wait_any();
+      if (!reaped) continue;  // a signal: the loop checks the stop flag
+      auto it = running.find(reaped->pid);
       if (it == running.end()) continue;
       Running& r = it->second;
-      // wait4's rusage covers the child and its reaped descendants (mpirun's ranks).
-      r.cpu += static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-      r.peak = std::max(r.peak, static_cast<double>(ru.ru_maxrss) / 1024.0);
+      const pipeline::ChildEnd end = pipeline::child_end(reaped->wait_status, reaped->usage, 0);
+      // wait4's rusage covers the child and its reaped descendants (mpirun's ranks):
+      // CPU time is their sum, ru_maxrss the largest single process.
+      r.cpu += end.cpu_s;
+      r.peak = std::max(r.peak, end.peak_memory_mb);
       const fs::path dir = run_dir(out_dir, plan.runs[r.run]);
-      const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+      const bool ok = end.ok();
       if (ok && r.command + 1 < r.commands.size()) {
         ++r.command;
         Running moved = std::move(r);
@@ -272,8 +264,7 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
       }
       std::string why;
       if (!ok) {
-        why = WIFSIGNALED(status) ? fmt::format("killed by signal {}", WTERMSIG(status))
-                                  : fmt::format("exit status {}", WEXITSTATUS(status));
+        why = end.describe();
         const std::string tail = tail_lines(dir / "run.log", 2);
         if (!tail.empty()) why += ": " + tail;
       }

@@ -30,6 +30,9 @@ struct RunResult {
   std::string status;   ///< "ok" or "failed"
   std::string message;  ///< failure reason (tail of run.log)
   double wall_s = 0, cpu_s = 0, peak_memory_mb = 0;
+  /// How peak_memory_mb was found: "wait4" (one process, or the largest of
+  /// mpirun's tree) or "sum over N ranks" (each rank's own peak, summary.yaml).
+  std::string peak_memory_rule;
   std::string host, version;
   int nproc = 0;
   double load_average = 0;  ///< 1-minute load when the run started
@@ -59,6 +62,14 @@ std::optional<RunResult> cached_result(const std::filesystem::path& dir, const H
 /// on SIGINT/SIGTERM (the children's process groups are stopped first).
 ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const std::filesystem::path& out_dir,
                        const ExecOptions& options, std::vector<RunResult>& results);
+
+/// The summary.yaml QoI in which an MPI command reports each rank's peak memory (MB).
+inline constexpr const char* kPerRankMemoryQoi = "peak_memory_mb_per_rank";
+
+/// For a run of `ranks` > 1 MPI ranks: the peak memory is the sum over ranks
+/// of the peaks the command reports in kPerRankMemoryQoi (issue 11), else
+/// wait4's value stays (the largest process) and the rule says why.
+void apply_rank_memory(RunResult& result, int ranks);
 
 /// Folder of a run.
 std::filesystem::path run_dir(const std::filesystem::path& out_dir, const RunSpec& run);

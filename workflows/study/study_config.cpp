@@ -10,6 +10,8 @@
 
 #include "common/config.hpp"
 #include "common/error.hpp"
+#include "common/units.hpp"
+#include "workflows/study/input_paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -163,7 +165,7 @@ YAML::Node get_dotted(const YAML::Node& root, const std::string& dotted) {
 
 StudyConfig load_study(const fs::path& file) {
   ConfigMap root = ConfigMap::load(file);
-  only_keys(root, {"name", "base", "overrides", "commands", "qoi", "reference", "error", "error_scale", "tolerance", "knobs", "grid", "ranks"});
+  only_keys(root, {"name", "base", "overrides", "commands", "qoi", "reference", "error", "error_scale", "tolerance", "knobs", "grid", "ranks", "base_time"});
   StudyConfig c;
   c.file = file;
   c.name = root.string("name", file.stem().string());
@@ -175,14 +177,21 @@ StudyConfig load_study(const fs::path& file) {
     root.fail("base", fmt::format("cannot parse '{}': {}", c.base_file.string(), e.what()));
   }
   c.base_name = c.base_file.filename().string();
+  // The runs' copies of the base live in their own folders: file names
+  // relative to the base (its mesh, fibers, lumen) become absolute here;
+  // names in overrides and knob values are relative to the study file.
+  resolve_relative_files(c.base, c.base_file.parent_path());
+  const fs::path study_folder = fs::absolute(file).parent_path();
   // overrides: {dotted.key: value} applied to the base for every run.
   if (root.has("overrides")) {
     const YAML::Node ov = root.node()["overrides"];
     if (!ov.IsMap()) root.fail("overrides", "expected a map of dotted keys to values");
     for (const auto& kv : ov) {
       const auto key = kv.first.as<std::string>();
+      YAML::Node value = YAML::Clone(kv.second);
+      resolve_relative_files(value, study_folder);
       try {
-        set_dotted(c.base, key, kv.second);
+        set_dotted(c.base, key, value);
       } catch (const std::invalid_argument& e) {
         throw InputError(fmt::format("{}: overrides.{}: does not fit the base file {}: {}", file.string(), key,
                                      c.base_file.string(), e.what()));
@@ -230,8 +239,15 @@ StudyConfig load_study(const fs::path& file) {
   c.error_scale = root.number("error_scale", 1.0, Range::positive());
   if (root.has("tolerance")) c.tolerance = root.number("tolerance", std::nullopt, Range::positive());
   c.base_ranks = root.integer("ranks", 1, Range::between(1, 4096));
+  if (root.has("base_time")) c.base_time_s = root.quantity("base_time", units::kTime, std::nullopt, Range::positive());
   std::set<std::string> names;
   for (auto& k : root.map_list("knobs")) c.knobs.push_back(read_knob(k, names));
+  for (auto& k : c.knobs)
+    for (auto& setting : k.values)
+      for (auto& v : setting) {
+        v = YAML::Clone(v);
+        resolve_relative_files(v, study_folder);
+      }
   if (c.knobs.empty()) root.fail("knobs", "a study needs at least one knob");
   for (const auto& k : c.knobs)
     for (const auto& key : k.keys) {

@@ -54,6 +54,9 @@ struct StudyConfig {
   std::vector<Knob> knobs;
   std::vector<std::string> grid;    ///< knobs varied as a full grid (besides one at a time)
   int base_ranks = 1;
+  /// Recorded wall time of the base run (`base_time: 4 s`): the dry run's
+  /// estimate before anything of the study was measured.
+  std::optional<double> base_time_s;
 };
 
 /// Reads and validates a study file. Throws InputError naming file, line and key.

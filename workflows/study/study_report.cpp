@@ -188,7 +188,7 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
     std::ostringstream csv;
     csv << "run,label,status,cached";
     for (const auto& k : s.knobs) csv << "," << csv_field(k.name);
-    csv << ",qoi,value,reference,error,wall_time_s,cpu_time_s,peak_memory_mb,ranks,host,nproc,load_average,binary_version,pareto,message";
+    csv << ",qoi,value,reference,error,wall_time_s,cpu_time_s,peak_memory_mb,peak_memory_rule,ranks,host,nproc,load_average,binary_version,pareto,message";
     for (const auto& name : qoi_names) csv << "," << csv_field("qoi." + name);
     csv << "\n";
     for (std::size_t i = 0; i < plan.runs.size(); ++i) {
@@ -197,7 +197,7 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
       csv << run.key << "," << csv_field(run.label) << "," << r.status << "," << (r.cached ? "yes" : "no");
       for (const auto& k : s.knobs) csv << "," << csv_field(setting_label(s, run, k.name));
       csv << "," << s.qoi << "," << num(o.value[i]) << "," << join(o.reference[i]) << "," << num(o.error[i]) << "," << num(r.wall_s)
-          << "," << num(r.cpu_s) << "," << num(r.peak_memory_mb) << "," << run.ranks << "," << csv_field(r.host) << "," << r.nproc << ","
+          << "," << num(r.cpu_s) << "," << num(r.peak_memory_mb) << "," << csv_field(r.peak_memory_rule) << "," << run.ranks << "," << csv_field(r.host) << "," << r.nproc << ","
           << num(r.load_average) << "," << r.version << "," << (front.count(i) ? "yes" : "no") << "," << csv_field(r.message);
       for (const auto& name : qoi_names) {
         auto it = r.qoi.find(name);
@@ -350,8 +350,8 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
     m << "\n\nPlots:";
     for (const auto& p : files.plots) m << " `" << p.filename().string() << "`";
     for (const auto& n : plot_notes) m << "\n" << n;
-    m << "\n\nNote: peak memory comes from wait4() of each run's process; for runs under mpirun it is the largest single "
-         "process, not yet the sum over ranks.\n";
+    m << "\n\nPeak memory: wait4() of each run's process; for a run on several MPI ranks the sum of the ranks' own peaks "
+         "(summary.yaml `" << kPerRankMemoryQoi << "`), see the CSV's peak_memory_rule.\n";
     files.markdown = out_dir / "study.md";
     files::write_atomic(files.markdown, m.str());
   }

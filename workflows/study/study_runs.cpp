@@ -10,6 +10,7 @@
 #include "common/config.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "workflows/study/input_paths.hpp"
 
 namespace stentsim::study {
 namespace {
@@ -20,7 +21,7 @@ const Knob& knob_named(const StudyConfig& s, const std::string& name) {
   throw std::logic_error("no knob " + name);
 }
 
-RunSpec make_run(const StudyConfig& s, const std::map<std::string, int>& setting) {
+RunSpec make_run(const StudyConfig& s, const std::map<std::string, int>& setting, FileHashes& hashes) {
   RunSpec r;
   r.setting = setting;
   r.input = YAML::Clone(s.base);
@@ -49,6 +50,8 @@ RunSpec make_run(const StudyConfig& s, const std::map<std::string, int>& setting
   r.input_text = std::string(em.c_str()) + "\n";
   std::string identity = canonical_yaml(r.input) + "\n#name " + s.base_name + "\n#ranks " + std::to_string(r.ranks);
   for (const auto& c : s.commands) identity += "\n#cmd " + fmt::format("{}", fmt::join(c, " "));
+  // A run reads the files its input names: a changed mesh is a new run.
+  for (const auto& f : referenced_files(r.input)) identity += "\n#file " + f.string() + " " + hashes.of(f);
   r.key = files::text_hash(identity).substr(0, 16);
   return r;
 }
@@ -58,8 +61,9 @@ RunSpec make_run(const StudyConfig& s, const std::map<std::string, int>& setting
 StudyPlan plan_study(const StudyConfig& s) {
   StudyPlan p;
   std::map<std::string, std::size_t> by_key;
+  FileHashes hashes;
   auto add = [&](const std::map<std::string, int>& setting) {
-    RunSpec r = make_run(s, setting);
+    RunSpec r = make_run(s, setting, hashes);
     auto [it, inserted] = by_key.try_emplace(r.key, p.runs.size());
     if (inserted) p.runs.push_back(std::move(r));
     else if (p.runs[it->second].setting.size() < setting.size()) {

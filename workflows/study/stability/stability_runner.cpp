@@ -19,6 +19,7 @@
 #include "common/files.hpp"
 #include "common/mesh_data.hpp"
 #include "pipeline/manifest.hpp"
+#include "workflows/study/input_paths.hpp"
 #include "workflows/version.hpp"
 
 namespace fs = std::filesystem;
@@ -377,8 +378,16 @@ StabilityReport run_stability_suite(const StabilitySuite& s, const StabilityOpti
     fs::path input_copy;
     if (c.kind != StabilityCase::Kind::exec) {
       YAML::Node root = YAML::LoadFile(c.input.string());
-      for (const auto& [key, value] : c.set)
-        set_dotted_key(root, key, with_suite_dir(value, fs::absolute(s.file).parent_path().string()));
+      // The copy runs in the case's folder: files the input names relative
+      // to itself, and those the suite's values name relative to the suite,
+      // are given by absolute path (workflows/study/input_paths.hpp).
+      resolve_relative_files(root, fs::absolute(c.input).parent_path());
+      const fs::path suite_dir = fs::absolute(s.file).parent_path();
+      for (const auto& [key, value] : c.set) {
+        YAML::Node v = with_suite_dir(value, suite_dir.string());
+        resolve_relative_files(v, suite_dir);
+        set_dotted_key(root, key, v);
+      }
       YAML::Emitter em;
       em << root;
       input_copy = dir / c.input.filename();

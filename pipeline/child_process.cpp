@@ -1,0 +1,177 @@
+#include "pipeline/child_process.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <thread>
+
+#include "common/error.hpp"
+
+namespace fs = std::filesystem;
+
+namespace stentsim::pipeline {
+namespace {
+
+double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
+
+/// The child's part of spawn(): group, signals, parent link, folder, log,
+/// environment. Only async-signal-safe calls until the body runs, except
+/// setenv (the child is single-threaded after fork as far as it matters).
+void set_up_child(const ChildSetup& s, pid_t parent) {
+  ::signal(SIGINT, SIG_DFL);
+  ::signal(SIGTERM, SIG_DFL);
+  ::setpgid(0, 0);
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (::getppid() != parent) ::_exit(1);  // the parent died before prctl took effect
+  if (!s.cwd.empty() && ::chdir(s.cwd.c_str()) != 0) ::_exit(126);
+  if (!s.log.empty()) {
+    const int fd = ::open(s.log.c_str(), O_WRONLY | O_CREAT | (s.append_log ? O_APPEND : O_TRUNC), 0644);
+    if (fd >= 0) {
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      ::close(fd);
+    }
+  }
+  for (const auto& [name, value] : s.env) ::setenv(name.c_str(), value.c_str(), 1);
+}
+
+}  // namespace
+
+pid_t spawn(const std::function<int()>& body, const ChildSetup& setup) {
+  if (!setup.log.empty() && setup.log.has_parent_path()) fs::create_directories(setup.log.parent_path());
+  std::fflush(nullptr);  // nothing buffered is written twice
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) throw ComputeError(fmt::format("cannot start a child process: fork failed: {}", std::strerror(errno)));
+  if (pid == 0) {
+    set_up_child(setup, parent);
+    int code = 1;
+    try {
+      code = body();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+    } catch (...) {
+      std::fprintf(stderr, "error: unknown exception in a child process\n");
+    }
+    std::fflush(nullptr);
+    ::_exit(code);  // no atexit handlers, no static destructors of the parent's objects
+  }
+  ::setpgid(pid, pid);  // also here: no race with a stop signal sent right after fork
+  return pid;
+}
+
+pid_t spawn_exec(const std::vector<std::string>& argv_s, const ChildSetup& setup) {
+  if (argv_s.empty()) throw ComputeError("cannot start a child process: empty command");
+  return spawn(
+      [&argv_s]() -> int {
+        std::vector<std::string> copy = argv_s;
+        std::vector<char*> argv;
+        for (auto& s : copy) argv.push_back(s.data());
+        argv.push_back(nullptr);
+        ::execvp(argv[0], argv.data());
+        std::fprintf(stderr, "cannot execute %s: %s\n", argv[0], std::strerror(errno));
+        std::fflush(nullptr);
+        ::_exit(127);
+      },
+      setup);
+}
+
+std::string ChildEnd::describe() const {
+  if (timed_out) return fmt::format("timed out after {:.0f} s", wall_s);
+  if (signal) return fmt::format("killed by signal {} ({})", signal, ::strsignal(signal));
+  return fmt::format("exit status {}", exit_code);
+}
+
+ChildEnd child_end(int wait_status, const rusage& ru, double wall_s) {
+  ChildEnd e;
+  e.wall_s = wall_s;
+  e.cpu_s = seconds(ru.ru_utime) + seconds(ru.ru_stime);
+  e.peak_memory_mb = static_cast<double>(ru.ru_maxrss) / 1024.0;  // kB on Linux
+  if (WIFEXITED(wait_status)) e.exit_code = WEXITSTATUS(wait_status);
+  else if (WIFSIGNALED(wait_status)) e.signal = WTERMSIG(wait_status);
+  return e;
+}
+
+std::optional<Reaped> wait_any() {
+  Reaped r;
+  r.pid = ::wait4(-1, &r.wait_status, 0, &r.usage);
+  if (r.pid >= 0) return r;
+  if (errno == EINTR) return std::nullopt;
+  throw ComputeError(fmt::format("waiting for child processes failed: {}", std::strerror(errno)));
+}
+
+std::vector<pid_t> descendants(pid_t root) {
+  std::vector<std::pair<pid_t, pid_t>> procs;  // pid, ppid
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/proc", ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::FILE* f = std::fopen((e.path() / "stat").c_str(), "r");
+    if (!f) continue;
+    char buf[512];
+    const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+    std::fclose(f);
+    buf[n] = 0;
+    const char* close = std::strrchr(buf, ')');  // the command name may hold spaces
+    int ppid = 0;
+    if (close && std::sscanf(close + 1, " %*c %d", &ppid) == 1) procs.emplace_back(std::stoi(name), ppid);
+  }
+  std::vector<pid_t> out{root};
+  for (std::size_t i = 0; i < out.size(); ++i)
+    for (const auto& [pid, ppid] : procs)
+      if (ppid == out[i]) out.push_back(pid);
+  out.erase(out.begin());
+  return out;
+}
+
+void signal_family(pid_t pid, int sig) {
+  const auto family = descendants(pid);
+  ::kill(-pid, sig);
+  for (pid_t d : family) ::kill(d, sig);
+}
+
+ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start, double limit_s, double grace_s) {
+  int status = 0;
+  rusage ru{};
+  bool timed_out = false;
+  std::chrono::steady_clock::time_point term_time;
+  std::vector<pid_t> family;  // the child's descendants when it was stopped
+  for (;;) {
+    const pid_t w = ::wait4(pid, &status, WNOHANG, &ru);
+    if (w == pid) break;
+    if (w < 0 && errno != EINTR) throw ComputeError(fmt::format("waiting for process {} failed: {}", pid, std::strerror(errno)));
+    const auto now = std::chrono::steady_clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    if (!timed_out && elapsed > limit_s) {
+      timed_out = true;
+      family = descendants(pid);
+      ::kill(-pid, SIGTERM);
+      for (pid_t d : family) ::kill(d, SIGTERM);
+      term_time = now;
+    } else if (timed_out && std::chrono::duration<double>(now - term_time).count() > grace_s) {
+      for (pid_t d : descendants(pid)) family.push_back(d);
+      ::kill(-pid, SIGKILL);
+      for (pid_t d : family) ::kill(d, SIGKILL);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(elapsed < 1 ? 5 : 50));
+  }
+  // Grandchildren left behind (a stage the child started) go with it.
+  if (timed_out) {
+    ::kill(-pid, SIGKILL);
+    for (pid_t d : family) ::kill(d, SIGKILL);
+  }
+  ChildEnd e = child_end(status, ru, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  e.timed_out = timed_out;
+  return e;
+}
+
+}  // namespace stentsim::pipeline

@@ -1,0 +1,85 @@
+#pragma once
+// Child processes for every runner that starts them: the stage runner (a
+// stage run in a forked child), the error study (stentsim runs, under mpirun
+// for ranks > 1) and the stability suite (cases under a wall-clock limit).
+// One implementation of the parts they share:
+//  - fork into a process group of its own (pgid = pid), so that a runner can
+//    stop a child and everything it started (mpirun's ranks, gmsh) with one
+//    kill(-pgid); the child dies with its parent (PR_SET_PDEATHSIG), so no
+//    orphan keeps working on (or locking) a folder;
+//  - stdout and stderr captured in a log file, environment set before exec;
+//  - exit status, CPU time and peak memory from wait4()'s rusage, which
+//    covers the child and its reaped descendants (ru_maxrss is the largest
+//    single process, not a sum: MPI runs report their ranks themselves);
+//  - a wall-clock limit: SIGTERM to the group and every descendant (a stage
+//    may sit in a group of its own), SIGKILL after a grace period.
+#include <sys/resource.h>
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace stentsim::pipeline {
+
+struct ChildSetup {
+  std::filesystem::path cwd;  ///< working folder of the child (empty: the parent's)
+  std::filesystem::path log;  ///< stdout and stderr go here (empty: inherited)
+  bool append_log = false;    ///< append to the log instead of truncating it
+  std::vector<std::pair<std::string, std::string>> env;  ///< variables set in the child
+};
+
+/// Forks a child set up as above that runs `body` and exits with its return
+/// value (1 after an exception, whose text goes to stderr). The child never
+/// returns into the caller. Throws ComputeError when fork fails.
+pid_t spawn(const std::function<int()>& body, const ChildSetup& setup = {});
+
+/// Forks and executes argv (execvp: argv[0] is looked up in PATH unless it
+/// holds a '/'). Exit 127 when it cannot execute (the reason is in the log),
+/// 126 when the working folder cannot be entered.
+pid_t spawn_exec(const std::vector<std::string>& argv, const ChildSetup& setup = {});
+
+/// How a child ended.
+struct ChildEnd {
+  int exit_code = -1;         ///< exit status when the child exited, else -1
+  int signal = 0;             ///< the signal that ended it (0: it exited)
+  bool timed_out = false;     ///< still running at its limit: ended by us
+  double wall_s = 0;          ///< from start to reaped
+  double cpu_s = 0;           ///< user + system time of the child and its reaped descendants
+  double peak_memory_mb = 0;  ///< largest resident set among them (wait4's ru_maxrss)
+  bool ok() const { return !timed_out && signal == 0 && exit_code == 0; }
+  /// "exit status 3", "killed by signal 9 (Killed)", "timed out after 61 s".
+  std::string describe() const;
+};
+
+/// The ChildEnd of a reaped child from its wait status and rusage.
+ChildEnd child_end(int wait_status, const rusage& usage, double wall_s);
+
+struct Reaped {
+  pid_t pid = -1;
+  int wait_status = 0;
+  rusage usage{};
+};
+
+/// Blocks until any child ends (wait4(-1)). nullopt when a signal interrupted
+/// the wait (EINTR: the caller checks its stop flag). Throws ComputeError on
+/// any other error.
+std::optional<Reaped> wait_any();
+
+/// Waits for `pid` (started at `start`). After `limit_s` seconds of wall clock
+/// the child's group and descendants get SIGTERM, SIGKILL `grace_s` later; the
+/// run then counts as timed out whatever its status. Descendants left behind
+/// by a timed-out child are killed too.
+ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start, double limit_s, double grace_s = 2.0);
+
+/// Sends `sig` to the child's process group and to every live descendant.
+void signal_family(pid_t pid, int sig);
+
+/// Every live descendant of `root` (from the ppid fields of /proc/*/stat).
+std::vector<pid_t> descendants(pid_t root);
+
+}  // namespace stentsim::pipeline

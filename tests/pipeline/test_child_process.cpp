@@ -1,0 +1,106 @@
+// pipeline/child_process: the one implementation of child processes that the
+// stage runner, the error study and the stability suite use. Small shell
+// commands: working folder, environment, log capture (truncate or append),
+// exit status, signal, CPU time and peak memory from wait4, and a function
+// body run in a fork.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "pipeline/child_process.hpp"
+
+namespace fs = std::filesystem;
+using namespace stentsim::pipeline;
+
+namespace {
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("stentsim_child_process_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string read(const fs::path& f) {
+  std::ifstream in(f);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+ChildEnd run(const std::vector<std::string>& argv, const ChildSetup& setup, double limit_s = 30) {
+  const auto start = std::chrono::steady_clock::now();
+  return wait_with_limit(spawn_exec(argv, setup), start, limit_s);
+}
+
+}  // namespace
+
+TEST(PipelineChildProcess, FolderEnvironmentAndLog) {
+  const fs::path d = fresh_dir("setup");
+  ChildSetup s;
+  s.cwd = d;
+  s.log = d / "logs" / "run.log";  // its folder is made
+  s.env = {{"STENTSIM_CHILD_TEST", "forty-two"}};
+  const ChildEnd e = run({"/bin/sh", "-c", "pwd; echo $STENTSIM_CHILD_TEST; echo oops >&2; exit 3"}, s);
+  EXPECT_EQ(e.exit_code, 3);
+  EXPECT_EQ(e.signal, 0);
+  EXPECT_FALSE(e.ok());
+  EXPECT_EQ(e.describe(), "exit status 3");
+  EXPECT_EQ(read(s.log), fs::canonical(d).string() + "\nforty-two\noops\n");
+  // Truncated by default, appended on request (a study's commands share run.log).
+  run({"/bin/sh", "-c", "echo first"}, s);
+  s.append_log = true;
+  run({"/bin/sh", "-c", "echo second"}, s);
+  EXPECT_EQ(read(s.log), "first\nsecond\n");
+  fs::remove_all(d);
+}
+
+TEST(PipelineChildProcess, ExecFailureSignalAndTiming) {
+  const fs::path d = fresh_dir("ends");
+  ChildSetup s;
+  s.log = d / "log";
+  const ChildEnd missing = run({"/nonexistent/tool", "x"}, s);
+  EXPECT_EQ(missing.exit_code, 127);
+  EXPECT_NE(read(s.log).find("cannot execute /nonexistent/tool"), std::string::npos) << read(s.log);
+  const ChildEnd killed = run({"/bin/sh", "-c", "kill -TERM $$"}, s);
+  EXPECT_EQ(killed.signal, SIGTERM);
+  EXPECT_NE(killed.describe().find("killed by signal 15"), std::string::npos) << killed.describe();
+  // A busy loop: CPU time is measured (wait4), close to the wall time it took alone.
+  const ChildEnd busy = run({"/bin/sh", "-c", "i=0; while [ $i -lt 200000 ]; do i=$((i+1)); done"}, s);
+  EXPECT_TRUE(busy.ok()) << busy.describe();
+  EXPECT_GT(busy.cpu_s, 0.02);
+  EXPECT_LE(busy.cpu_s, busy.wall_s * 1.05 + 0.01);
+  EXPECT_GT(busy.peak_memory_mb, 0.5);
+  const ChildEnd slow = run({"sleep", "20"}, s, 0.3);
+  EXPECT_TRUE(slow.timed_out);
+  EXPECT_LT(slow.wall_s, 5);
+  EXPECT_NE(slow.describe().find("timed out"), std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST(PipelineChildProcess, BodyRunsInItsOwnProcessGroup) {
+  const fs::path d = fresh_dir("body");
+  ChildSetup s;
+  s.log = d / "log";
+  const pid_t parent_group = ::getpgrp();
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t pid = spawn(
+      [&]() -> int {
+        std::printf("group %s\n", ::getpgrp() == ::getpid() && ::getpgrp() != parent_group ? "own" : "shared");
+        throw stentsim::ComputeError("body failed");
+      },
+      s);
+  const ChildEnd e = wait_with_limit(pid, start, 30);
+  EXPECT_EQ(e.exit_code, 1);  // an exception in the body
+  const std::string log = read(s.log);
+  EXPECT_NE(log.find("group own"), std::string::npos) << log;
+  EXPECT_NE(log.find("error: body failed"), std::string::npos) << log;
+  EXPECT_THROW(spawn_exec({}), stentsim::ComputeError);
+  fs::remove_all(d);
+}
