@@ -31,11 +31,16 @@ namespace {
 
 bool is_volume(CellType t) { return t == CellType::hexahedron || t == CellType::tetra || t == CellType::quadratic_tetra; }
 
-std::vector<std::array<Vec3, 3>> cell_frames(const BodyDesc& b, const std::filesystem::path& scene) {
-  std::vector<std::array<Vec3, 3>> frames;
+/// Frames per body cell (and, from a fiber field file, the fiber directions per cell) into `spec`.
+/// A fibers.vtu (the fibers stage's: volume cells only, in the artery mesh's order) matches the
+/// body either cell for cell or volume cell for volume cell (the artery VTU also holds its
+/// boundary faces); the cell types and centroids must agree, so a field made for another mesh
+/// is an error rather than a silently wrong fiber architecture.
+void cell_frames(const BodyDesc& b, const std::filesystem::path& scene, SolidBodySpec& spec) {
   const MeshData& m = b.mesh;
-  if (b.frames.kind == FrameSource::Kind::none) return frames;
-  frames.resize(m.num_cells());
+  if (b.frames.kind == FrameSource::Kind::none) return;
+  auto& frames = spec.cell_frames;
+  frames.assign(m.num_cells(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
   if (b.frames.kind == FrameSource::Kind::cylindrical) {
     for (std::size_t c = 0; c < m.num_cells(); ++c) {
       Vec3 x = Vec3::Zero();
@@ -48,20 +53,68 @@ std::vector<std::array<Vec3, 3>> cell_frames(const BodyDesc& b, const std::files
       er.normalize();
       frames[c] = {er, b.frames.axis.cross(er), b.frames.axis};
     }
-    return frames;
+    return;
   }
-  const MeshData f = read_vtu(b.frames.file.string());
-  if (f.num_cells() != m.num_cells())
-    throw InputError(fmt::format("{}: {} cells, but body '{}' has {}", b.frames.file.string(), f.num_cells(), b.name, m.num_cells()));
-  const std::array<std::string, 3> names{b.frames.radial, b.frames.circumferential, b.frames.longitudinal};
-  for (int k = 0; k < 3; ++k) {
-    auto it = f.cell_data.find(names[static_cast<std::size_t>(k)]);
-    if (it == f.cell_data.end() || it->second.components != 3)
-      throw InputError(fmt::format("{}: expected a 3-component cell array '{}'", b.frames.file.string(), names[static_cast<std::size_t>(k)]));
+  const std::string file = b.frames.file.string();
+  const MeshData f = read_vtu(file);
+  // Body cell of each file cell.
+  std::vector<std::size_t> body_cell;
+  if (f.num_cells() == m.num_cells()) {
+    for (std::size_t c = 0; c < m.num_cells(); ++c) body_cell.push_back(c);
+  } else {
     for (std::size_t c = 0; c < m.num_cells(); ++c)
-      frames[c][static_cast<std::size_t>(k)] = Vec3(it->second.at(c, 0), it->second.at(c, 1), it->second.at(c, 2));
+      if (is_volume(m.cell_types[c])) body_cell.push_back(c);
+    if (body_cell.size() != f.num_cells())
+      throw InputError(fmt::format("{}: fiber_frames.file {} has {} cells, but body '{}' ({}) has {} cells, {} of them volume cells",
+                                   scene.string(), file, f.num_cells(), b.name, b.mesh_source, m.num_cells(), body_cell.size()));
   }
-  return frames;
+  double extent = 0.0;
+  for (const auto& p : m.points) extent = std::max(extent, p.cwiseAbs().maxCoeff());
+  auto centroid = [](const MeshData& mesh, std::size_t c) {
+    Vec3 x = Vec3::Zero();
+    const auto conn = mesh.cell(c);
+    for (auto n : conn) x += mesh.points[static_cast<std::size_t>(n)];
+    return Vec3(x / static_cast<double>(conn.size()));
+  };
+  for (std::size_t k = 0; k < f.num_cells(); ++k) {
+    const std::size_t c = body_cell[k];
+    if (f.cell_types[k] != m.cell_types[c] || (centroid(f, k) - centroid(m, c)).norm() > 1e-6 * std::max(extent, 1.0))
+      throw InputError(fmt::format("{}: fiber_frames.file {}: cell {} (type {}, centroid off by {:.3g} mm) does not match cell {} of "
+                                   "body '{}' (type {}): the fiber field was made for another mesh",
+                                   scene.string(), file, k, static_cast<int>(f.cell_types[k]), (centroid(f, k) - centroid(m, c)).norm(),
+                                   c, b.name, static_cast<int>(m.cell_types[c])));
+  }
+  auto array = [&](const std::string& name, const char* role) -> const DataArray& {
+    auto it = f.cell_data.find(name);
+    if (it == f.cell_data.end() || it->second.components != 3)
+      throw InputError(fmt::format("{}: fiber_frames.file {}: expected a 3-component cell array '{}' ({}){}", scene.string(), file,
+                                   name, role,
+                                   std::string(role) == "fiber family" ? "; set fiber_frames.fibers: none to build fiber "
+                                                                         "directions from the frame and the material angles"
+                                                                       : ""));
+    return it->second;
+  };
+  const std::array<std::string, 3> names{b.frames.radial, b.frames.circumferential, b.frames.longitudinal};
+  for (int i = 0; i < 3; ++i) {
+    const DataArray& a = array(names[static_cast<std::size_t>(i)], "frame");
+    for (std::size_t k = 0; k < f.num_cells(); ++k)
+      frames[body_cell[k]][static_cast<std::size_t>(i)] = Vec3(a.at(k, 0), a.at(k, 1), a.at(k, 2));
+  }
+  if (b.frames.fibers.empty()) return;
+  spec.fibers_per_cell = static_cast<int>(b.frames.fibers.size());
+  std::array<Vec3, kMaxFiberFamilies> zero;
+  zero.fill(Vec3::Zero());
+  spec.cell_fibers.assign(m.num_cells(), zero);
+  for (std::size_t i = 0; i < b.frames.fibers.size(); ++i) {
+    const DataArray& a = array(b.frames.fibers[i], "fiber family");
+    for (std::size_t k = 0; k < f.num_cells(); ++k) {
+      const Vec3 v(a.at(k, 0), a.at(k, 1), a.at(k, 2));
+      if (!(std::abs(v.norm() - 1.0) < 1e-6))
+        throw InputError(fmt::format("{}: fiber_frames.file {}: '{}' of cell {} has length {:.6g}, expected a unit vector",
+                                     scene.string(), file, b.frames.fibers[i], k, v.norm()));
+      spec.cell_fibers[body_cell[k]][i] = v;
+    }
+  }
 }
 
 struct Built {
@@ -257,7 +310,12 @@ std::unique_ptr<Built> build(const SceneDesc& scene) {
       spec.cell_material[c] = it->second;
     }
     if (solids == 0) throw InputError(fmt::format("{}: body '{}': the mesh ({}) has no hex8/tet4/tet10 cells", file, b.name, b.mesh_source));
-    spec.cell_frames = cell_frames(b, scene.file);
+    cell_frames(b, scene.file, spec);
+    if (b.frames.kind == FrameSource::Kind::file)
+      log::info("body '{}': frames{} per cell from {}", b.name,
+                b.frames.fibers.empty() ? std::string(" (fiber directions from the material angles)")
+                                        : fmt::format(" and fiber directions ({})", fmt::join(b.frames.fibers, ", ")),
+                b.frames.file.string());
     const GlobalDof first = model.dofs.allocate(b.name, 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
     try {
       out->bodies[b.name] = &model.add_term<SolidBody>(std::move(spec), first);
@@ -409,6 +467,33 @@ std::vector<std::pair<double, double>> radial_snapshot(const Built& b, const Eig
   return s;
 }
 
+/// The 6 rigid-body modes of the solid nodes, for SA-AMG with 3 equations per node.
+/// A model with beam bodies or multipliers has nodes with 9, 6 or 3 beam DOFs and
+/// unknowns that are no displacement: a fixed 3-DOF block cannot aggregate them and
+/// the solid modes say nothing about them, so such scenes are refused (direct or
+/// gmres_ilu solve them). Nodes held in a local frame ("radial only") carry their
+/// modes in that frame, as the assembled system does (global_system.hpp).
+Eigen::MatrixXd amg_near_null_space(const SceneDesc& scene, const Built& b) {
+  const Model& model = b.model;
+  const std::string where = fmt::format("{}: solver.linear.type: gmres_amg", scene.file.string());
+  if (!b.beams.empty())
+    throw InputError(fmt::format("{} needs 3 displacement DOFs per node, but body '{}' is a beam body (6-9 DOFs per node); "
+                                 "use direct or gmres_ilu", where, b.beams.begin()->first));
+  GlobalDof solid = 0;
+  std::vector<std::pair<GlobalDof, Vec3>> nodes;
+  for (const auto& [name, body] : b.bodies) {
+    solid += body->num_dofs();
+    for (std::size_t i = 0; i < body->num_nodes(); ++i) nodes.emplace_back(body->dof(i, 0), body->mesh().points[i]);
+  }
+  if (solid != model.dofs.size())
+    throw InputError(fmt::format("{}: the model has {} unknowns that are not solid displacements (e.g. multipliers); "
+                                 "use direct or gmres_ilu", where, model.dofs.size() - solid));
+  Eigen::MatrixXd modes = model.rigid_body_modes(nodes);
+  for (const auto& [d0, x] : nodes)
+    if (const Mat3* q = model.constraints.frame(d0)) modes.middleRows<3>(d0) = q->transpose() * modes.middleRows<3>(d0);
+  return modes;
+}
+
 int qoi_beam_node(const QoiDesc& q, const Built& b) {
   return beams::select_beam_nodes(*b.beam_desc.at(q.body), q.node).at(0);
 }
@@ -469,12 +554,7 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: solver.linear.type: {}", scene_yaml.string(), e.what()));
   }
-  {
-    std::vector<std::pair<GlobalDof, Vec3>> nodes;
-    for (const auto& [name, body] : built->bodies)
-      for (std::size_t i = 0; i < body->num_nodes(); ++i) nodes.emplace_back(body->dof(i, 0), body->mesh().points[i]);
-    linear->set_near_null_space(model.rigid_body_modes(nodes));
-  }
+  if (scene.linear.type == "gmres_amg") linear->set_near_null_space(amg_near_null_space(scene, *built));
   // Ranks: after the linear solver exists (Trilinos initialises MPI when the
   // CLI has not). Every rank holds u; elements are split; rank 0 writes.
   model.rank = parallel::rank();
@@ -482,6 +562,9 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   const bool writes = model.rank == 0;
   if (!writes) log::set_level(log::Level::warn);
   log::info("linear solver: {}; {} MPI rank(s)", linear->describe(), model.ranks);
+  if (scene.linear.type == "direct" && model.ranks > 1)
+    log::info("direct solver on {} ranks: the assembled matrix is gathered on rank 0 and factored there with Eigen "
+              "SparseLU (serial; memory and time of one rank); use gmres_ilu or gmres_amg for large models", model.ranks);
 
   ResultsWriter writer(writes ? out_dir : std::filesystem::temp_directory_path() /
                                               fmt::format("stentsim_rank{}_{}", model.rank, ::getpid()));

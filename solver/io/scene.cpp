@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <numbers>
 #include <set>
+#include <sstream>
 
 #include "common/error.hpp"
 #include "solver/io/generated_meshes.hpp"
@@ -159,6 +160,15 @@ SceneDesc read_scene(const std::filesystem::path& file) {
         body.frames.radial = f->string("radial", body.frames.radial);
         body.frames.circumferential = f->string("circumferential", body.frames.circumferential);
         body.frames.longitudinal = f->string("longitudinal", body.frames.longitudinal);
+        // Words: the fiber arrays for families 1, 2, ... ("Fiber1 Fiber2", the fibers stage's), or "none".
+        if (f->has("fibers")) {
+          std::istringstream words(f->string("fibers"));
+          body.frames.fibers.clear();
+          for (std::string w; words >> w;)
+            if (w != "none") body.frames.fibers.push_back(w);
+          if (static_cast<int>(body.frames.fibers.size()) > kMaxFiberFamilies)
+            f->fail("fibers", fmt::format("at most {} fiber arrays (one per family)", kMaxFiberFamilies));
+        }
       } else {
         b.fail("fiber_frames", "expected 'cylindrical: {origin, axis}' or 'file: fibers.vtu'");
       }

@@ -26,6 +26,9 @@ struct FrameSource {
   Vec3 origin = Vec3::Zero(), axis = Vec3::UnitZ();  // cylindrical
   std::filesystem::path file;                        // a VTU with one cell per body cell
   std::string radial = "Radial", circumferential = "Circumferential", longitudinal = "Longitudinal";
+  /// file: cell arrays with the fiber direction of family 1, 2, ... of each cell's material
+  /// (families given by angle); empty (`fibers: none`) = rebuild them from the frame and the angles.
+  std::vector<std::string> fibers{"Fiber1", "Fiber2"};
 };
 
 struct BodyDesc {

@@ -24,6 +24,10 @@ struct LinearSolverSettings {
   /// field such as the fibers' Laplace problems). Without a near-null space
   /// MueLu then uses the constant per component.
   int amg_equations_per_node = 3;
+  /// Krylov solvers: start from the `x` passed to solve() (when it has the
+  /// right size) instead of zero, and measure convergence against |b| (not
+  /// the initial residual) so a good start saves iterations.
+  bool use_initial_guess = false;
   int verbosity = 0;
 };
 
@@ -32,6 +36,9 @@ struct LinearSolveStats {
   double relative_residual = 0.0;
   bool converged = false;
   double setup_seconds = 0.0, solve_seconds = 0.0;
+  /// gmres_amg: levels of the MueLu hierarchy built for this solve (1 = the
+  /// system was at or below the coarse size and was not coarsened); 0 otherwise.
+  int amg_levels = 0;
 };
 
 class LinearSolver {
@@ -42,6 +49,10 @@ class LinearSolver {
   /// `x` receives the full solution on every rank.
   virtual LinearSolveStats solve(const CsrMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
   /// Near-null space for AMG (n x k, e.g. the 6 rigid-body modes); ignored by others.
+  /// gmres_amg throws InputError at the next solve when its row count is not
+  /// the system's, or when a row is zero in every mode (a DOF the modes do not
+  /// describe, e.g. a beam rotation or a multiplier): SA-AMG with a fixed block
+  /// of `amg_equations_per_node` would otherwise build a wrong coarse space.
   virtual void set_near_null_space(const Eigen::MatrixXd& modes) {}
   virtual std::string describe() const = 0;
 };

@@ -10,6 +10,8 @@
 #include <BelosTpetraAdapter.hpp>
 #include <Ifpack2_Factory.hpp>
 #include <MueLu_CreateTpetraPreconditioner.hpp>
+#include <MueLu_Hierarchy.hpp>
+#include <MueLu_TpetraOperator.hpp>
 #include <Teuchos_ParameterList.hpp>
 #include <Tpetra_Core.hpp>
 #include <Tpetra_CrsMatrix.hpp>
@@ -24,6 +26,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/error.hpp"
 #include "solver/linalg/linear_solver.hpp"
 
 namespace stentsim::solver {
@@ -64,7 +67,7 @@ class TrilinosSolver : public LinearSolver {
 
   std::string describe() const override {
     if (settings_.type == "direct")
-      return comm_->getSize() > 1 ? "direct: matrix gathered on rank 0, sparse LU" : "Amesos2 KLU2 (direct)";
+      return comm_->getSize() > 1 ? "direct: matrix gathered on rank 0, Eigen SparseLU there (serial)" : "Amesos2 KLU2 (direct)";
     std::ostringstream o;
     o << "Belos block GMRES (Krylov space " << settings_.krylov_size << ", tol " << settings_.tolerance << ") + ";
     if (settings_.type == "gmres_ilu") o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
@@ -82,6 +85,8 @@ class TrilinosSolver : public LinearSolver {
     RCP<MV> bv = rcp(new MV(map, 1)), xv = rcp(new MV(map, 1));
     for (LO i = 0; i < static_cast<LO>(map->getNodeNumElements()); ++i) bv->replaceLocalValue(i, 0, b(map->getGlobalElement(i)));
     xv->putScalar(0.0);
+    if (settings_.use_initial_guess && x.size() == a.rows)
+      for (LO i = 0; i < static_cast<LO>(map->getNodeNumElements()); ++i) xv->replaceLocalValue(i, 0, x(map->getGlobalElement(i)));
 
     if (settings_.type == "direct" && comm_->getSize() > 1) {
       // Amesos2 KLU2 on a distributed matrix returned wrong solutions with
@@ -101,7 +106,7 @@ class TrilinosSolver : public LinearSolver {
       stats.iterations = 1;
       stats.converged = true;
     } else {
-      RCP<OP> prec = make_preconditioner(mat, map);
+      RCP<OP> prec = make_preconditioner(mat, map, stats);
       const auto t1 = Clock::now();
       auto problem = rcp(new Belos::LinearProblem<SC, MV, OP>(mat, xv, bv));
       problem->setRightPrec(prec);
@@ -111,6 +116,10 @@ class TrilinosSolver : public LinearSolver {
       params->set("Maximum Iterations", settings_.max_iterations);
       params->set("Maximum Restarts", std::max(1, settings_.max_iterations / std::max(1, settings_.krylov_size)));
       params->set("Convergence Tolerance", settings_.tolerance);
+      if (settings_.use_initial_guess) {  // tolerance relative to |b| (the same test as from x = 0)
+        params->set("Implicit Residual Scaling", std::string("Norm of RHS"));
+        params->set("Explicit Residual Scaling", std::string("Norm of RHS"));
+      }
       params->set("Verbosity", settings_.verbosity > 0 ? Belos::Errors + Belos::Warnings + Belos::FinalSummary
                                                         : Belos::Errors);
       Belos::BlockGmresSolMgr<SC, MV, OP> gmres(problem, params);
@@ -200,7 +209,25 @@ class TrilinosSolver : public LinearSolver {
     return stats;
   }
 
-  RCP<OP> make_preconditioner(const RCP<Matrix>& mat, const RCP<const Map>& map) const {
+  // SA-AMG needs a near-null space that describes every row with the fixed
+  // block size: a silently dropped or partly zero null space gives a coarse
+  // space without the rigid-body modes (slow or stalled GMRES) and no message.
+  void check_near_null_space(GO n) const {
+    const int eq = settings_.amg_equations_per_node;
+    if (eq > 1 && n % eq != 0)
+      throw InputError("gmres_amg: " + std::to_string(n) + " unknowns are not a multiple of " + std::to_string(eq) +
+                         " equations per node (mixed DOF kinds, e.g. beam nodes or multipliers: use direct or gmres_ilu)");
+    if (modes_.size() == 0) return;
+    if (modes_.rows() != static_cast<Eigen::Index>(n))
+      throw InputError("gmres_amg: the near-null space has " + std::to_string(modes_.rows()) + " rows but the system has " +
+                         std::to_string(n));
+    for (Eigen::Index i = 0; i < modes_.rows(); ++i)
+      if (modes_.row(i).isZero(0.0))
+        throw InputError("gmres_amg: unknown " + std::to_string(i) + " is zero in every near-null-space mode (a DOF " +
+                           "the rigid-body modes do not describe, e.g. a beam rotation or a multiplier: use direct or gmres_ilu)");
+  }
+
+  RCP<OP> make_preconditioner(const RCP<Matrix>& mat, const RCP<const Map>& map, LinearSolveStats& stats) const {
     if (settings_.type == "gmres_ilu") {
       using RowMatrix = Tpetra::RowMatrix<SC, LO, GO, NO>;
       Teuchos::ParameterList p;
@@ -228,7 +255,8 @@ class TrilinosSolver : public LinearSolver {
       p.set("number of equations", settings_.amg_equations_per_node);
       p.set("coarse: max size", 1000);
       p.set("smoother: type", std::string("CHEBYSHEV"));
-      if (modes_.rows() == static_cast<Eigen::Index>(map->getGlobalNumElements()) && modes_.cols() > 0) {
+      check_near_null_space(static_cast<GO>(map->getGlobalNumElements()));
+      if (modes_.size() > 0) {
         RCP<MV> ns = rcp(new MV(map, static_cast<std::size_t>(modes_.cols())));
         for (LO i = 0; i < static_cast<LO>(map->getNodeNumElements()); ++i)
           for (Eigen::Index c = 0; c < modes_.cols(); ++c)
@@ -236,7 +264,9 @@ class TrilinosSolver : public LinearSolver {
         p.sublist("user data").set("Nullspace", ns);
       }
       RCP<OP> op = mat;
-      return MueLu::CreateTpetraPreconditioner(op, p);
+      RCP<MueLu::TpetraOperator<SC, LO, GO, NO>> prec = MueLu::CreateTpetraPreconditioner(op, p);
+      stats.amg_levels = prec->GetHierarchy()->GetNumLevels();
+      return prec;
     }
     throw std::invalid_argument("unknown Krylov preconditioner for '" + settings_.type + "'");
   }

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "common/error.hpp"
 #include "common/log.hpp"
 #include "solver/terms/element_failure.hpp"
 
@@ -51,6 +52,8 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     LinearSolveStats ls;
     try {
       ls = linear.solve(system.matrix(), system.rhs(), du);
+    } catch (const InputError&) {
+      throw;  // a set-up the scene must change (e.g. AMG on a model it cannot describe): no step cut helps
     } catch (const std::exception& e) {
       return fail(fmt::format("linear solver failed: {}", e.what()));
     }
@@ -110,8 +113,9 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     const bool r_ok = r_norm <= settings.residual_tolerance * scale + settings.residual_absolute;
     const bool du_ok = du_norm <= settings.increment_tolerance * std::max(u.norm(), 1e-12) ||
                        du_norm <= settings.increment_absolute || r_norm == 0.0;
-    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}", it, r_norm,
-               scale, du_norm, best_alpha, ls.iterations);
+    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}", it, r_norm,
+               scale, du_norm, best_alpha, ls.iterations,
+               ls.amg_levels > 0 ? fmt::format(" (AMG levels {})", ls.amg_levels) : std::string());
     // Round-off floor: an increment at machine precision cannot improve the state
     // further (tiny loads on stiff models leave |R| just above an absolute tolerance).
     const bool stagnated = du_norm <= 1e-13 * std::max(u.norm(), 1e-300) && it > 1;

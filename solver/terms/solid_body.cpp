@@ -56,6 +56,11 @@ SolidBody::SolidBody(SolidBodySpec spec, GlobalDof first_dof)
       Vec3 a;
       if (fam.global_direction) {
         a = *fam.global_direction;
+      } else if (!spec.cell_fibers.empty()) {
+        if (spec.cell_fibers.size() != mesh_.num_cells() || static_cast<int>(f) >= spec.fibers_per_cell)
+          throw InputError(fmt::format("body '{}': material '{}' has {} fiber families but the fiber field gives {} "
+                                       "direction(s) per cell", name_, mat.name, mat.fibers.size(), spec.fibers_per_cell));
+        a = spec.cell_fibers[c][f];
       } else {
         if (spec.cell_frames.size() != mesh_.num_cells())
           throw InputError(fmt::format("body '{}': material '{}' gives fiber angles but the body has no local "

@@ -22,6 +22,12 @@ struct SolidBodySpec {
   /// e_longitudinal) that fiber angles refer to. Required when a material has
   /// fiber families given by angle.
   std::vector<std::array<Vec3, 3>> cell_frames;
+  /// Optional fiber directions per mesh cell from a fiber field (the fibers
+  /// stage's Fiber1, Fiber2, ...): family f of the cell's material, when given
+  /// by angle, takes cell_fibers[c][f] (f < fibers_per_cell) instead of the
+  /// direction rebuilt from cell_frames and the angle.
+  std::vector<std::array<Vec3, kMaxFiberFamilies>> cell_fibers;
+  int fibers_per_cell = 0;
 };
 
 /// Per-cell output of a solid body.

@@ -1,6 +1,6 @@
 // Run under mpirun -np 2: the same problem solved serially on each rank
 // (Eigen LU, all elements) and in parallel (elements split over the ranks,
-// direct (gathered on rank 0) and GMRES + Schwarz-ILU(k) over the ranks) must agree to solver
+// direct (gathered on rank 0), GMRES + Schwarz-ILU(k) and GMRES + SA-AMG over the ranks) must agree to solver
 // tolerance. A media tube (fibers + viscous history) under inner pressure.
 #include <mpi.h>
 
@@ -65,6 +65,11 @@ Eigen::VectorXd solve(int rank, int ranks, const std::string& linear_type) {
   ls.type = linear_type;
   ls.tolerance = 1e-12;
   auto linear = make_linear_solver(ls);
+  if (linear_type == "gmres_amg") {
+    std::vector<std::pair<GlobalDof, Vec3>> nodes;
+    for (std::size_t i = 0; i < body.num_nodes(); ++i) nodes.emplace_back(body.dof(i, 0), body.mesh().points[i]);
+    linear->set_near_null_space(model.rigid_body_modes(nodes));
+  }
   Eigen::VectorXd u = Eigen::VectorXd::Zero(model.dofs.size());
   StepperSettings st;
   st.dt_initial = 0.25;
@@ -84,7 +89,7 @@ int main(int argc, char** argv) {
     const int rank = parallel::rank(), ranks = parallel::size();
     if (std::getenv("STENTSIM_DEBUG")) log::set_level(log::Level::debug);
     const Eigen::VectorXd serial = solve(0, 1, "eigen_lu");
-    for (const char* type : {"direct", "gmres_ilu"}) {
+    for (const char* type : {"direct", "gmres_ilu", "gmres_amg"}) {
       const Eigen::VectorXd par = solve(rank, ranks, type);
       const double diff = (par - serial).norm() / serial.norm();
       if (rank == 0) std::printf("%d ranks, %s vs serial: relative difference %.2e (|u| = %.4e)\n", ranks, type, diff, serial.norm());

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "common/error.hpp"
@@ -54,9 +55,48 @@ TEST(SolverScene, TubeExampleMatchesReference) {
   std::ifstream h(out / "history.csv");
   std::string line;
   int rows = -1;
-  while (std::getline(h, line)) ++rows;
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> table;
+  auto split = [](const std::string& l) {
+    std::vector<std::string> cells;
+    std::stringstream ss(l);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    return cells;
+  };
+  while (std::getline(h, line)) {
+    if (++rows == 0) {
+      header = split(line);
+      continue;
+    }
+    std::vector<double> row;
+    for (const auto& cell : split(line)) row.push_back(std::stod(cell));
+    table.push_back(row);
+  }
   EXPECT_GE(rows, 4);
   EXPECT_LE(rows, 8);
+  // The documented columns in this order (history.csv of README's solver section), one per pressure condition.
+  const std::vector<std::string> columns{"step", "time", "dt", "load_factor", "newton_iterations", "linear_iterations",
+                                         "step_cuts", "wall_time_s", "assembly_s", "linear_solve_s", "pressure_lumen_pressure"};
+  std::map<std::string, std::size_t> at;
+  for (std::size_t i = 0; i < header.size(); ++i) EXPECT_TRUE(at.emplace(header[i], i).second) << "column twice: " << header[i];
+  std::size_t previous = 0;
+  for (const auto& c : columns) {
+    ASSERT_TRUE(at.count(c)) << "history.csv lacks column " << c;
+    if (&c != &columns.front()) EXPECT_GT(at[c], previous) << c << " out of order";
+    previous = at[c];
+  }
+  ASSERT_FALSE(table.empty());
+  for (const auto& row : table) ASSERT_EQ(row.size(), header.size());
+  EXPECT_DOUBLE_EQ(table.back()[at["time"]], 1.0);
+  EXPECT_DOUBLE_EQ(table.back()[at["load_factor"]], 1.0);         // no load_factor curve: the time
+  EXPECT_NEAR(table.back()[at["pressure_lumen_pressure"]], 0.12, 1e-10);  // 0.12 MPa x ramp(1)
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    EXPECT_DOUBLE_EQ(table[i][at["step"]], static_cast<double>(i + 1));
+    EXPECT_GE(table[i][at["newton_iterations"]], 1.0);
+    EXPECT_NEAR(table[i][at["pressure_lumen_pressure"]], 0.12 * table[i][at["time"]], 1e-10);
+    if (i > 0) EXPECT_NEAR(table[i][at["time"]] - table[i - 1][at["time"]], table[i][at["dt"]], 1e-9);
+  }
   // Hoop stress at the inner wall is the largest principal stress and positive.
   int last = 0;
   while (std::filesystem::exists(out / fmt::format("results/tube_{:05d}.vtu", last + 1))) ++last;
