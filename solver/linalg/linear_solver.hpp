@@ -24,10 +24,6 @@ struct LinearSolverSettings {
   /// field such as the fibers' Laplace problems). Without a near-null space
   /// MueLu then uses the constant per component.
   int amg_equations_per_node = 3;
-  /// Krylov solvers: start from the `x` passed to solve() (when it has the
-  /// right size) instead of zero, and measure convergence against |b| (not
-  /// the initial residual) so a good start saves iterations.
-  bool use_initial_guess = false;
   int verbosity = 0;
 };
 

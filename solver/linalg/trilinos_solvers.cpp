@@ -85,8 +85,6 @@ class TrilinosSolver : public LinearSolver {
     RCP<MV> bv = rcp(new MV(map, 1)), xv = rcp(new MV(map, 1));
     for (LO i = 0; i < static_cast<LO>(map->getNodeNumElements()); ++i) bv->replaceLocalValue(i, 0, b(map->getGlobalElement(i)));
     xv->putScalar(0.0);
-    if (settings_.use_initial_guess && x.size() == a.rows)
-      for (LO i = 0; i < static_cast<LO>(map->getNodeNumElements()); ++i) xv->replaceLocalValue(i, 0, x(map->getGlobalElement(i)));
 
     if (settings_.type == "direct" && comm_->getSize() > 1) {
       // Amesos2 KLU2 on a distributed matrix returned wrong solutions with
@@ -116,10 +114,6 @@ class TrilinosSolver : public LinearSolver {
       params->set("Maximum Iterations", settings_.max_iterations);
       params->set("Maximum Restarts", std::max(1, settings_.max_iterations / std::max(1, settings_.krylov_size)));
       params->set("Convergence Tolerance", settings_.tolerance);
-      if (settings_.use_initial_guess) {  // tolerance relative to |b| (the same test as from x = 0)
-        params->set("Implicit Residual Scaling", std::string("Norm of RHS"));
-        params->set("Explicit Residual Scaling", std::string("Norm of RHS"));
-      }
       params->set("Verbosity", settings_.verbosity > 0 ? Belos::Errors + Belos::Warnings + Belos::FinalSummary
                                                         : Belos::Errors);
       Belos::BlockGmresSolMgr<SC, MV, OP> gmres(problem, params);
