@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <map>
 #include <filesystem>
 #include <string>
 
@@ -52,7 +54,8 @@ TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << r.out;
   const auto csv = read_text(dir / "cohort.work/cohort_summary.csv");
-  EXPECT_NE(csv.find("\"coarse\",\"done\""), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"case\",\"status\",\"exit_code\",\"failed_stage\",\"message\""), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"coarse\",\"done\",\"0\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("mesh.artery_elements"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\"256\""), std::string::npos) << csv;  // 16 x 4 x 4 hex8 for `coarse`
   // Second run: every case's stages are up to date.
@@ -85,7 +88,7 @@ TEST_F(Cohort, UnexpectedOutcomeExitsOne) {
   auto r = sh("cohort run " + f);
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("odd: succeeded unexpectedly"), std::string::npos) << r.out;
-  EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.csv").find("\"odd\",\"succeeded unexpectedly\""), std::string::npos);
+  EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.csv").find("\"odd\",\"succeeded unexpectedly\",\"0\""), std::string::npos);
 }
 
 TEST_F(Cohort, ExpectedFailureStageNotRunIsDone) {
@@ -115,6 +118,144 @@ TEST_F(Cohort, BadCohortFilesStopBeforeAnythingRuns) {
   EXPECT_FALSE(fs::exists(dir / "cohort.work"));
 }
 
+// Issue 10: "a case whose input file is missing: a clear error before anything
+// runs" -- found by building the case's pipeline plan at load time.
+TEST_F(Cohort, MissingInputFileStopsBeforeAnythingRuns) {
+  write_atomic(dir / "patient.yaml", "name: p\nscene: patient\ninput: {phantom: {preset: straight-healthy}}\n");
+  const fs::path f = dir / "missing.yaml";
+  write_atomic(f, "template: patient.yaml\ncases:\n  - id: fine\n"
+                  "  - id: gone\n    overrides: {input: {phantom: null, surface: {lumen: scans/p7.stl}}}\n");
+  const auto r = sh("cohort run " + f.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(f.string() + ": case 'gone': input.surface.lumen: input file not found: " +
+                       (dir / "scans/p7.stl").string()),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(fs::exists(dir / "missing.work"));  // not even the case that is fine ran
+  EXPECT_EQ(sh("cohort status " + f.string()).code, 2);
+}
+
+// An open tube of radius r along z as an ASCII STL (a lumen with two open ends).
+void write_tube_stl(const fs::path& f, double r) {
+  const int na = 24, nl = 24;
+  const double length = 12.0;
+  auto p = [&](int i, int j) {
+    const double a = 2 * M_PI * j / na;
+    return std::array<double, 3>{r * std::cos(a), r * std::sin(a), length * i / nl};
+  };
+  std::string s = "solid tube\n";
+  for (int i = 0; i < nl; ++i)
+    for (int j = 0; j < na; ++j) {
+      const auto a = p(i, j), b = p(i, (j + 1) % na), c = p(i + 1, (j + 1) % na), d = p(i + 1, j);
+      for (const auto& tri : {std::array<std::array<double, 3>, 3>{a, b, c}, std::array<std::array<double, 3>, 3>{a, c, d}}) {
+        s += " facet normal 0 0 0\n  outer loop\n";
+        for (const auto& v : tri) s += "   vertex " + std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
+        s += "  endloop\n endfacet\n";
+      }
+    }
+  write_atomic(f, s + "endsolid tube\n");
+}
+
+// Issue 10: "a folder glob of inputs, e.g. every STL in a folder": one case per
+// file, id from the file name, the file put in the given key; duplicates rejected.
+TEST_F(Cohort, CasesFromAGlobOfStlFiles) {
+  write_atomic(dir / "patient.yaml", "name: p\nscene: patient\ninput: {phantom: {preset: straight-healthy}}\n");
+  const double radius[3] = {1.0, 1.25, 1.5};
+  const char* names[3] = {"p01", "p02", "p03"};
+  for (int i = 0; i < 3; ++i) write_tube_stl(dir / "scans" / (std::string(names[i]) + ".stl"), radius[i]);
+  write_atomic(dir / "scans/notes.txt", "not a case\n");
+  const fs::path f = dir / "stl.yaml";
+  write_atomic(f, "template: patient.yaml\nworkers: 2\ncases:\n  - id: phantom\n"
+                  "cases_from:\n  glob: scans/*.stl\n  key: input.surface.lumen\n"
+                  "  overrides: {input: {phantom: null, surface: {units: mm}}}\n");
+  auto r = sh("cohort run " + f.string() + " --until segmentation");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("4 cases: 4 as expected"), std::string::npos) << r.out;
+  // Each case got its own file: the lumen area 2 pi r L (24-gon: x sin(pi/24)/(pi/24)).
+  const std::string csv = read_text(dir / "stl.work/cohort_summary.csv");
+  for (int i = 0; i < 3; ++i) {
+    const std::string merged = read_text(dir / "stl.work" / names[i] / "case.yaml");
+    EXPECT_NE(merged.find((dir / "scans" / (std::string(names[i]) + ".stl")).string()), std::string::npos) << merged;
+    EXPECT_EQ(merged.find("phantom"), std::string::npos) << merged;  // removed by the null override
+    const fs::path summary = dir / "stl.work" / names[i] / "work/segmentation/summary.yaml";
+    const std::string s = read_text(summary);
+    const double area = 2 * M_PI * radius[i] * 12.0 * std::sin(M_PI / 24) / (M_PI / 24);
+    const auto at = s.find("lumen_surface_area");
+    ASSERT_NE(at, std::string::npos) << s;
+    const auto v = s.find("value:", at);
+    EXPECT_NEAR(std::stod(s.substr(v + 6)), area, 1e-3 * area) << names[i];
+    EXPECT_NE(csv.find("\"" + std::string(names[i]) + "\",\"done\",\"0\""), std::string::npos) << csv;
+  }
+  EXPECT_NE(csv.find("\"phantom\",\"done\""), std::string::npos) << csv;
+  // An id that a glob file repeats, and a glob that matches nothing: errors before anything runs.
+  write_atomic(f, "template: patient.yaml\ncases:\n  - id: p02\n"
+                  "cases_from: [{glob: scans/*.stl, key: input.surface.lumen, overrides: {input: {phantom: null}}}]\n");
+  r = sh("cohort run " + f.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cases_from[0].glob: duplicate case id 'p02' (from " + (dir / "scans/p02.stl").string()), std::string::npos)
+      << r.out;
+  write_atomic(f, "template: patient.yaml\ncases_from: {glob: scans/*.vtp, key: input.surface.lumen}\n");
+  r = sh("cohort run " + f.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cases_from.glob: 'scans/*.vtp' matches no file"), std::string::npos) << r.out;
+  // A wrong key is reported with the case, the key and the file it came from.
+  write_atomic(f, "template: patient.yaml\ncases_from: {glob: scans/p01.stl, key: input.surface.lumn, "
+                  "overrides: {input: {phantom: null}}}\n");
+  r = sh("cohort run " + f.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("case 'p01' (input.surface.lumn from " + (dir / "scans/p01.stl").string() + ")"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("input.surface.lumen: required file path is missing"), std::string::npos) << r.out;
+}
+
+// --dry-run with the Slurm back-end prints the array it would submit and
+// submits nothing: sbatch here is a fake that leaves a mark if it is called.
+TEST_F(Cohort, SlurmDryRunSubmitsNothing) {
+  const fs::path bin = dir / "fake-bin";
+  for (const char* tool : {"sbatch", "squeue", "scancel", "scontrol"}) {
+    write_atomic(bin / tool, "#!/bin/sh\necho \"$0 $*\" >> " + (dir / "called").string() + "\necho 42\n");
+    fs::permissions(bin / tool, fs::perms::owner_all);
+  }
+  const auto f = cohort("  - id: a\n  - id: b\n    overrides: {mesh: {generic: {elements_around: 20}}}\n");
+  const std::string env = "PATH=" + bin.string() + ":$PATH ";
+  const std::string out = [&] {
+    std::string o;
+    FILE* p = ::popen((env + STENTSIM_TEST_BINARY + " cohort run " + f + " --backend slurm --dry-run --until mesh 2>&1; echo exit=$?").c_str(), "r");
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, p)) o += buf;
+    ::pclose(p);
+    return o;
+  }();
+  EXPECT_NE(out.find("exit=0"), std::string::npos) << out;
+  EXPECT_NE(out.find("(dry run, nothing is submitted): 2 cases: 2 to submit"), std::string::npos) << out;
+  EXPECT_NE(out.find("'--array=0-1'"), std::string::npos) << out;
+  EXPECT_NE(out.find("| cases=( 'a' 'b' )"), std::string::npos) << out;
+  EXPECT_NE(out.find("run case.yaml '--until' 'mesh' > run.log"), std::string::npos) << out;  // the real run's arguments
+  EXPECT_EQ(out.find("--dry-run' >"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir / "called")) << read_text(dir / "called");
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/cohort_manifest.yaml"));
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/slurm"));
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/a/work"));
+  // A local dry run prints each case's plan and runs nothing either.
+  const auto r = sh("cohort run " + f + " --dry-run --until mesh");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("== a =="), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("run   mesh"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/a/work/mesh"));
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/cohort_summary.csv"));
+}
+
+// ETA from the median stage times so far: each unfinished case needs the
+// sampled stages it has not finished, `parallel` at a time.
+TEST(CohortEta, MedianStageTimesOverRemainingWork) {
+  using stentsim::workflows::cohort_eta;
+  EXPECT_FALSE(cohort_eta({}, {{}, {}}, 2));
+  const std::map<std::string, std::vector<double>> samples = {{"segmentation", {1, 3, 2}}, {"centerline", {4, 6}}};
+  // medians 2 and 5: one case past segmentation (5 left), one not started (7 left), 2 at once.
+  EXPECT_DOUBLE_EQ(*cohort_eta(samples, {{"segmentation"}, {}}, 2), 6.0);
+  EXPECT_DOUBLE_EQ(*cohort_eta(samples, {{"segmentation", "centerline"}}, 1), 0.0);
+  EXPECT_DOUBLE_EQ(*cohort_eta(samples, {{}, {}, {}}, 0), 21.0);  // at least one at a time
+}
+
 TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-example-" + std::to_string(::getpid()));
   fs::remove_all(dir);
@@ -126,7 +267,7 @@ TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("severe               failed as expected at placement"), std::string::npos) << r.out;
   const auto csv = read_text(dir / "cohort.work/cohort_summary.csv");
-  EXPECT_NE(csv.find("\"severe\",\"failed as expected\",\"placement\""), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"severe\",\"failed as expected\",\"1\",\"placement\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("\"rca-seed1\",\"done\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("placement.placement_min_clearance [mm]"), std::string::npos) << csv;
   // A PNG per numeric QoI beside the CSV, and the Markdown summary.

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -128,30 +129,51 @@ class CohortSlurm : public ::testing::Test {
     write_atomic(f, "name: " + name + "\ntemplate: patient.yaml\nworkers: 2\n" + backend +
                         "cases:\n"
                         "  - id: rca-seed1\n"
-                        "  - id: straight\n    overrides: {input: {phantom: {preset: straight-healthy}}}\n"
+                        "  - id: straight\n    overrides: {input: {phantom: {preset: straight-healthy}}, "
+                        "device: {placement: {site_abscissa: 10 mm}}}\n"
                         "  - id: severe\n    overrides: {input: {phantom: {preset: severe-70}}}\n    expect_failure: placement\n");
     return f.string();
   }
   fs::path cluster, dir;
 };
 
+// All three cases up to placement, where severe-70 fails as it declares
+// (expect_failure: placement): the array's results equal the local pool's.
 TEST_F(CohortSlurm, JobArrayGivesTheLocalResults) {
   const auto local = cohort("local", "");
-  auto r = sh("cohort run " + local + " --until centerline");
+  auto r = sh("cohort run " + local + " --until placement");
   ASSERT_EQ(r.code, 0) << r.out;
   const auto slurm = cohort("slurm", "backend: slurm\nslurm: {partition: debug, time_limit: \"10\", memory: 500M, poll_interval_s: 0.2}\n");
-  r = sh("cohort run " + slurm + " --until centerline");
+  // A dry run shows the array and submits nothing.
+  const std::string jobs_before = capture("squeue -h -t all -o %i");
+  r = sh("cohort run " + slurm + " --until placement --dry-run");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("(dry run, nothing is submitted): 3 cases: 3 to submit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("'--array=0-2'"), std::string::npos) << r.out;
+  EXPECT_EQ(active_queue(), "");
+  EXPECT_EQ(capture("squeue -h -t all -o %i"), jobs_before);  // not even a probe job
+  EXPECT_FALSE(fs::exists(dir / "slurm.work/cohort_manifest.yaml"));
+
+  r = sh("cohort run " + slurm + " --until placement");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("probe job"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("submitted job array"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("(3 task(s) of 1 rank(s)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("severe               failed as expected at placement"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << r.out;
+  // The waiting line carries an ETA once a task has finished (median stage times).
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("slurm: [0-9]+ pending, [0-9]+ running, [12]/3 finished, ETA [0-9]+ s")))
+      << r.out;
   const auto a = results(dir / "local.work/cohort_summary.csv");
   const auto b = results(dir / "slurm.work/cohort_summary.csv");
   ASSERT_EQ(a.size(), 3u);
-  EXPECT_EQ(a, b);  // same statuses and same QoIs, case by case
+  EXPECT_EQ(a, b);  // same statuses, exit codes and QoIs, case by case
   EXPECT_EQ(b.at("rca-seed1").at("status"), "done");
+  EXPECT_EQ(b.at("severe").at("status"), "failed as expected");
+  EXPECT_EQ(b.at("severe").at("failed_stage"), "placement");
+  EXPECT_EQ(b.at("severe").at("exit_code"), "1");
   EXPECT_FALSE(b.at("rca-seed1").at("centerline.min_radius [mm]").empty());
+  EXPECT_FALSE(b.at("rca-seed1").at("placement.placement_min_clearance [mm]").empty());
   // One array: tasks <job>_0.._2 in cohort order, each with its exit-code file and Slurm output.
   const auto t = tasks_of(dir / "slurm.work");
   ASSERT_EQ(t.size(), 3u);
@@ -160,8 +182,11 @@ TEST_F(CohortSlurm, JobArrayGivesTheLocalResults) {
   EXPECT_EQ(t.at("straight"), job + "_1");
   EXPECT_EQ(t.at("severe"), job + "_2");
   EXPECT_EQ(read_text(dir / "slurm.work/straight/exit_code"), "0 " + job + "_1\n");
+  EXPECT_EQ(read_text(dir / "slurm.work/severe/exit_code"), "1 " + job + "_2\n");
   EXPECT_NE(read_text(dir / ("slurm.work/slurm/slurm-" + job + "_1.out")).find("case straight: exit 0"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "slurm.work/plot_centerline.min_radius.png"));
+  r = sh("cohort status " + slurm);
+  EXPECT_NE(status_line(r.out, "severe").find(t.at("severe") + " failed as expected"), std::string::npos) << r.out;
 
   // A submission the cluster rejects is a clear error and leaves no jobs behind.
   const auto bad = cohort("bad", "backend: slurm\nslurm: {partition: nope}\n");

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <fstream>
 #include <iostream>
 #include <optional>
 
@@ -46,6 +47,7 @@ int cohort_status(const std::string& file) {
   for (const auto& s : workflows::all_stage_names()) std::cout << fmt::format(" {:<12}", s);
   if (slurm) std::cout << fmt::format(" {:<12} {}", "slurm task", "slurm state");
   std::cout << "\n";
+  std::vector<std::string> running_notes;
   for (std::size_t i = 0; i < c.cases.size(); ++i) {
     const auto cc = workflows::load_case(case_files[i]);
     pipeline::Runner r(pipeline::Plan(workflows::stages_for(cc), cc.work_dir), kVersion);
@@ -55,12 +57,22 @@ int cohort_status(const std::string& file) {
                        : st.state == pipeline::StageState::failed  ? "failed"
                        : st.state == pipeline::StageState::stale   ? "stale"
                                                                    : "-";
+    // Running: a local runner holds the case's work-folder lock; a Slurm task
+    // runs on a node whose lock we cannot see, so there squeue says so.
+    const auto act = workflows::case_activity(cc.work_dir);
+    const bool slurm_running = slurm && (*slurm)[i].state == "running";
+    if (act.running || slurm_running) {
+      for (const auto& s : act.running ? act.stages : workflows::stages_in_progress(cc.work_dir)) state[s] = "running";
+      running_notes.push_back(fmt::format("{}: running ({})", c.cases[i].id,
+                                          act.running ? act.holder : "Slurm task " + (*slurm)[i].job));
+    }
     std::cout << fmt::format("{:<20}", c.cases[i].id);
     for (const auto& s : workflows::all_stage_names())
       std::cout << fmt::format(" {:<12}", state.count(s) ? state[s] : "");
     if (slurm) std::cout << fmt::format(" {:<12} {}", (*slurm)[i].job, (*slurm)[i].state);
     std::cout << "\n";
   }
+  for (const auto& n : running_notes) std::cout << n << "\n";
   // Failures and lost tasks with their messages (the tail of run.log or of the Slurm output).
   if (slurm)
     for (const auto& s : *slurm)
@@ -99,6 +111,7 @@ void register_cohort(CLI::App& app) {
       throw InputError(fmt::format("{}: --no-wait needs the slurm back-end (backend: slurm or --backend slurm)", c.file.string()));
     workflows::CohortRunOptions o;
     o.no_wait = a->no_wait;
+    o.dry_run = a->dry_run;
     o.workers = a->workers;
     o.only_cases = split(a->cases);
     o.binary = self_binary();
@@ -111,6 +124,14 @@ void register_cohort(CLI::App& app) {
     if (a->dry_run) o.run_args.push_back("--dry-run");
     const auto rep = c.backend == "slurm" ? workflows::run_cohort_slurm(c, o, std::cout) : workflows::run_cohort(c, o, std::cout);
     if (!rep.waited) return 0;
+    if (a->dry_run) {  // each case's plan, from its log; no summary: nothing ran
+      for (const auto& r : rep.cases) {
+        std::cout << fmt::format("== {} ==\n", r.id);
+        std::ifstream log(c.work_dir / r.id / "run.log");
+        std::cout << log.rdbuf();
+      }
+      return rep.exit_code();
+    }
     workflows::write_cohort_summary(c, rep);
     std::cout << fmt::format("{} cases: {} as expected, {} unexpected failures; summary: {}\n", rep.cases.size(),
                              rep.cases.size() - static_cast<std::size_t>(rep.unexpected()), rep.unexpected(),
@@ -122,7 +143,7 @@ void register_cohort(CLI::App& app) {
     return rep.exit_code();
   });
   auto file = std::make_shared<std::string>();
-  auto* status = cohort->add_subcommand("status", "Table of cases x stages (done, stale, failed) and, for Slurm, each case's task and state");
+  auto* status = cohort->add_subcommand("status", "Table of cases x stages (done, stale, failed, running) and, for Slurm, each case's task and state");
   status->add_option("cohort", *file, "Cohort file (YAML)")->required();
   on(status, [file] { return cohort_status(*file); });
 }

@@ -1,8 +1,10 @@
 #include "workflows/cohort/cohort_config.hpp"
 
 #include <fmt/format.h>
+#include <glob.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <regex>
 #include <sstream>
 #include <set>
@@ -10,6 +12,7 @@
 #include "common/config.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "pipeline/plan.hpp"
 #include "workflows/case_config.hpp"
 #include "workflows/case_stages.hpp"
 
@@ -18,15 +21,66 @@ namespace fs = std::filesystem;
 namespace stentsim::workflows {
 namespace {
 
-/// Deep merge: maps merge key by key, anything else replaces.
+/// Deep merge: maps merge key by key, anything else replaces; a null value
+/// removes the key (as in JSON merge patch, RFC 7396), so a case can drop a
+/// template section, e.g. `input: {phantom: null}` before giving a surface.
 YAML::Node merge(const YAML::Node& base, const YAML::Node& over) {
   if (!over.IsMap() || !base.IsMap()) return YAML::Clone(over);
   YAML::Node out = YAML::Clone(base);
   for (const auto& kv : over) {
     const std::string k = kv.first.Scalar();
-    out[k] = out[k] ? merge(out[k], kv.second) : YAML::Clone(kv.second);
+    if (kv.second.IsNull()) out.remove(k);
+    else if (kv.second.IsMap()) out[k] = merge(out[k] && out[k].IsMap() ? out[k] : YAML::Node(YAML::NodeType::Map), kv.second);
+    else out[k] = YAML::Clone(kv.second);
   }
   return out;
+}
+
+/// The dotted key whose (absolutized) scalar value is `value`, searched in a
+/// merged case: it turns "<path>: input file of stage X not found" into the
+/// case key the user wrote.
+std::string key_holding(const YAML::Node& node, const std::string& value, const std::string& prefix = "") {
+  if (!node.IsMap()) return "";
+  for (const auto& kv : node) {
+    const std::string k = prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar();
+    if (kv.second.IsScalar() && kv.second.Scalar() == value) return k;
+    if (auto found = key_holding(kv.second, value, k); !found.empty()) return found;
+  }
+  return "";
+}
+
+/// Sets `dotted` ("input.surface.lumen") in a map, creating the maps on the way.
+void set_dotted(YAML::Node node, const std::string& dotted, const std::string& value) {
+  const auto dot = dotted.find('.');
+  if (dot == std::string::npos) {
+    node[dotted] = value;
+    return;
+  }
+  const std::string head = dotted.substr(0, dot);
+  if (!node[head] || !node[head].IsMap()) node[head] = YAML::Node(YAML::NodeType::Map);
+  set_dotted(node[head], dotted.substr(dot + 1), value);
+}
+
+/// The files a glob pattern matches, sorted (glob(3): *, ?, [...] in any
+/// path component; no **).
+std::vector<fs::path> glob_files(const std::string& pattern) {
+  glob_t g{};
+  const int rc = ::glob(pattern.c_str(), 0, nullptr, &g);
+  std::vector<fs::path> out;
+  if (rc == 0)
+    for (std::size_t i = 0; i < g.gl_pathc; ++i)
+      if (fs::is_regular_file(g.gl_pathv[i])) out.emplace_back(g.gl_pathv[i]);
+  ::globfree(&g);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// A case id from a file name: the name without its extension ("p01.stl" ->
+/// "p01"; "p01.nii.gz" -> "p01").
+std::string id_from_file(const fs::path& f) {
+  fs::path stem = f.stem();
+  if (f.extension() == ".gz" || f.extension() == ".bz2" || f.extension() == ".xz") stem = stem.stem();
+  return stem.string();
 }
 
 /// Relative file paths in the template are relative to the template's folder;
@@ -108,7 +162,42 @@ CohortConfig load_cohort(const fs::path& file) {
     k.finish();
     c.cases.push_back(std::move(cc));
   }
-  if (c.cases.empty()) top.fail("cases", "a cohort needs at least one case");
+  // cases_from: one case per file a glob matches (issue 10: "every STL in a
+  // folder"); a single map or a list of them.
+  std::vector<ConfigMap> globs;
+  if (top.has("cases_from") && top.node()["cases_from"].IsMap()) globs.push_back(top.map("cases_from"));
+  else globs = top.map_list("cases_from");
+  for (auto& g : globs) {
+    const std::string pattern_text = g.string("glob");
+    fs::path pattern(pattern_text);
+    if (pattern.is_relative()) pattern = c.file.parent_path() / pattern;
+    const std::string key = g.string("key");
+    if (!std::regex_match(key, std::regex("[A-Za-z_][A-Za-z0-9_]*(\\.[A-Za-z_][A-Za-z0-9_]*)*")))
+      g.fail("key", fmt::format("'{}' is not a dotted case key such as input.surface.lumen", key));
+    YAML::Node common = YAML::Clone(g.map("overrides").node());
+    absolutize_paths(common, c.file.parent_path());
+    std::optional<std::string> expect;
+    if (g.has("expect_failure")) expect = g.choice("expect_failure", all_stage_names());
+    g.finish();
+    const auto files = glob_files(pattern.lexically_normal().string());
+    if (files.empty()) g.fail("glob", fmt::format("'{}' matches no file ({})", pattern_text, pattern.lexically_normal().string()));
+    for (const auto& f : files) {
+      CohortCase cc;
+      cc.id = id_from_file(f);
+      if (!std::regex_match(cc.id, id_ok))
+        g.fail("glob", fmt::format("{}: '{}' is not a valid case id (letters, digits, '_', '.', '-'); rename the file",
+                                   f.string(), cc.id));
+      if (!ids.insert(cc.id).second)
+        g.fail("glob", fmt::format("duplicate case id '{}' (from {}): case ids must be unique across cases and cases_from",
+                                   cc.id, f.string()));
+      cc.overrides = YAML::Clone(common);
+      set_dotted(cc.overrides, key, fs::absolute(f).lexically_normal().string());
+      cc.expect_failure = expect;
+      cc.origin = fmt::format("{} from {}", key, f.string());
+      c.cases.push_back(std::move(cc));
+    }
+  }
+  if (c.cases.empty()) top.fail("cases", "a cohort needs at least one case (cases: or cases_from:)");
   top.finish();
   // Validate every merged case now, so nothing runs when one is wrong.
   const fs::path check_dir = fs::temp_directory_path() / fmt::format("stentsim-cohort-check-{}", ::getpid());
@@ -116,14 +205,25 @@ CohortConfig load_cohort(const fs::path& file) {
     const fs::path f = check_dir / (k.id + ".yaml");
     files::write_atomic(f, emit(merged_case(c, k)));
     try {
-      load_case(f);
+      // The case file and its plan, as `stentsim run` builds them: the plan
+      // checks that every external input file (input.surface.lumen, ...) exists.
+      const CaseConfig cc = load_case(f);
+      pipeline::Plan plan(stages_for(cc), cc.work_dir);
     } catch (const InputError& e) {
       fs::remove_all(check_dir);
       std::string msg = e.what();
       const std::string prefix = f.string() + ":";
       // The line numbers refer to the merged file, not the cohort file: drop them.
       if (msg.rfind(prefix, 0) == 0) msg = std::regex_replace(msg.substr(prefix.size()), std::regex("^[0-9]+:[0-9]+: "), "");
-      throw InputError(fmt::format("{}: case '{}': {}", c.file.string(), k.id, msg));
+      // A missing input file: name the case key that gave it.
+      static const std::regex missing("^(.*): input file of stage '([^']+)' not found$");
+      std::smatch m;
+      if (std::regex_match(msg, m, missing)) {
+        const std::string key = key_holding(merged_case(c, k), m[1].str());
+        msg = fmt::format("{}input file not found: {} (needed by stage {})", key.empty() ? "" : key + ": ", m[1].str(),
+                          m[2].str());
+      }
+      throw InputError(fmt::format("{}: case '{}'{}: {}", c.file.string(), k.id, k.origin.empty() ? "" : " (" + k.origin + ")", msg));
     }
   }
   fs::remove_all(check_dir);

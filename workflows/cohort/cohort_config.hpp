@@ -15,6 +15,7 @@ struct CohortCase {
   std::string id;
   YAML::Node overrides;                    // merged into the template, key by key
   std::optional<std::string> expect_failure;  // stage at which this case is meant to fail
+  std::string origin;                      // cases_from: "<key> from <file>" (for messages); empty for `cases`
 };
 
 /// `backend: slurm` settings (`slurm:` map of the cohort file).
@@ -33,7 +34,7 @@ struct CohortConfig {
   std::filesystem::path work_dir;          // <cohort>.work beside the file by default
   YAML::Node template_case;                // the template case (a map)
   std::filesystem::path template_dir;      // relative paths in the template resolve here
-  std::vector<CohortCase> cases;
+  std::vector<CohortCase> cases;           // `cases`, then one per file of each `cases_from` glob
   int workers = 0;                         // 0: the core count
   int ranks_per_case = 1;
   std::string backend = "local";           // local | slurm
@@ -41,7 +42,15 @@ struct CohortConfig {
 };
 
 /// Reads and validates a cohort file, including every case's merged
-/// configuration. Throws InputError naming the file, the case id and the key.
+/// configuration and its pipeline plan (so a missing input file is caught
+/// here). Throws InputError naming the file, the case id and the key.
+///
+/// Cases come from `cases:` (id, overrides, expect_failure) and from
+/// `cases_from:` (a map or a list of maps): `glob:` a file pattern relative to
+/// the cohort file, `key:` the dotted case key each matched file is put in
+/// (e.g. input.surface.lumen), optional `overrides:` and `expect_failure:` for
+/// all of them. Their ids are the file names without extension; ids are unique
+/// across both. In overrides a null value removes a template key.
 CohortConfig load_cohort(const std::filesystem::path& file);
 
 /// The case file of one case: template with overrides, work_dir "work".

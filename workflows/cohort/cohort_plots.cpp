@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 namespace stentsim::workflows {
 namespace {
 
-const std::vector<std::string> kFixedColumns = {"case", "status", "failed_stage", "message", "wall_time_s"};
+const std::vector<std::string> kFixedColumns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s"};
 
 bool is_fixed(const std::string& col) {
   return std::find(kFixedColumns.begin(), kFixedColumns.end(), col) != kFixedColumns.end();

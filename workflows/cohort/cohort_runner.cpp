@@ -3,13 +3,18 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <fstream>
+#include <sstream>
 #include <map>
 #include <ostream>
 #include <set>
@@ -29,6 +34,49 @@ namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_cohort_stop(int sig) { g_stop = sig; }
+extern "C" void on_cohort_child(int) {}  // only wakes sigsuspend
+
+/// While the pool runs, SIGINT, SIGTERM and SIGCHLD are blocked except inside
+/// sigsuspend: a stop signal can then never fall between the check of the stop
+/// flag and the wait (it used to be lost there, and the pool waited for every
+/// running case to end on its own), nor between fork and the registration of
+/// the new worker. Restores handlers and mask on every way out.
+class PoolSignals {
+ public:
+  PoolSignals() {
+    g_stop = 0;
+    sigset_t block;
+    sigemptyset(&block);
+    for (int s : {SIGINT, SIGTERM, SIGCHLD}) sigaddset(&block, s);
+    sigprocmask(SIG_BLOCK, &block, &old_mask_);
+    wait_mask_ = old_mask_;
+    for (int s : {SIGINT, SIGTERM, SIGCHLD}) sigdelset(&wait_mask_, s);
+    struct sigaction sa {};
+    sigemptyset(&sa.sa_mask);
+    sa.sa_handler = on_cohort_stop;
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+    sa.sa_handler = on_cohort_child;
+    sa.sa_flags = SA_NOCLDSTOP;
+    sigaction(SIGCHLD, &sa, &old_chld_);
+  }
+  ~PoolSignals() {
+    // Unblock first, with our handlers still in place: a stop signal that
+    // arrived after the last wait sets the flag instead of killing the process.
+    sigprocmask(SIG_SETMASK, &old_mask_, nullptr);
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+    sigaction(SIGCHLD, &old_chld_, nullptr);
+  }
+  /// Sleeps until a signal arrives (a worker ended, or a stop).
+  void wait() const { sigsuspend(&wait_mask_); }
+  /// The mask a worker starts with (the caller's, before the pool blocked).
+  const sigset_t& worker_mask() const { return old_mask_; }
+
+ private:
+  sigset_t old_mask_{}, wait_mask_{};
+  struct sigaction old_int_ {}, old_term_ {}, old_chld_ {};
+};
 
 std::string tail_lines(const fs::path& file, int n) {
   std::ifstream in(file);
@@ -56,15 +104,29 @@ bool stage_succeeded(const fs::path& manifest_file, const std::string& stage) {
   return rec && rec->status == "ok";
 }
 
-pid_t start_case(const std::string& binary, const fs::path& case_file, const std::vector<std::string>& args, const fs::path& log) {
+// Called with SIGINT/SIGTERM/SIGCHLD blocked (PoolSignals): the child resets
+// the handlers to their defaults before it unblocks, so a Ctrl-C that reached
+// it between fork and exec ends it instead of setting a flag nobody reads.
+pid_t start_case(const std::string& binary, const fs::path& case_file, const std::vector<std::string>& args, const fs::path& log,
+                 const sigset_t& worker_mask) {
   std::vector<std::string> argv_s = {binary, "run", case_file.string()};
   argv_s.insert(argv_s.end(), args.begin(), args.end());
   fs::create_directories(log.parent_path());
+  std::vector<char*> argv;  // built before fork: the child only calls async-signal-safe functions
+  for (auto& s : argv_s) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  const pid_t parent = ::getpid();
+  std::fflush(nullptr);
   pid_t pid = ::fork();
-  if (pid < 0) throw ComputeError("cohort: fork failed");
+  if (pid < 0) throw ComputeError(fmt::format("cohort: fork failed: {}", std::strerror(errno)));
   if (pid == 0) {
     ::signal(SIGINT, SIG_DFL);
     ::signal(SIGTERM, SIG_DFL);
+    ::signal(SIGCHLD, SIG_DFL);
+    // A worker dies with the pool (SIGTERM: its runner stops its stage and
+    // keeps earlier artifacts), so a killed `cohort run` leaves no orphans.
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != parent) ::_exit(130);
     int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd >= 0) {
       ::dup2(fd, 1);
@@ -73,14 +135,20 @@ pid_t start_case(const std::string& binary, const fs::path& case_file, const std
     }
     // One thread per library inside a cohort: cases already use every core.
     ::setenv("OMP_NUM_THREADS", "1", 1);
-    std::vector<char*> argv;
-    for (auto& s : argv_s) argv.push_back(s.data());
-    argv.push_back(nullptr);
+    sigprocmask(SIG_SETMASK, &worker_mask, nullptr);
     ::execv(binary.c_str(), argv.data());
     std::perror("cohort: exec of stentsim failed");
     ::_exit(127);
   }
   return pid;
+}
+
+const char* const kStartup = "(case start-up)";
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 }  // namespace
@@ -102,6 +170,9 @@ CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_co
   else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
   else r.status = r.exit_code == 130 ? "interrupted" : "failed";
   if (r.exit_code) r.message = tail_lines(dir / "run.log", 3);
+  if (r.exit_code > 128 && r.exit_code != 130)  // the worker itself was killed: its log cannot say so
+    r.message = fmt::format("stentsim run killed by signal {} ({}){}", r.exit_code - 128, strsignal(r.exit_code - 128),
+                            r.message.empty() ? "" : "; log: " + r.message);
   return r;
 }
 
@@ -126,6 +197,67 @@ int concurrent_cases(int workers, int ranks_per_case, int cores) {
   return std::max(1, std::min(workers, cores / std::max(1, ranks_per_case)));
 }
 
+std::vector<std::string> stages_in_progress(const fs::path& case_work_dir) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& name : all_stage_names())
+    if (fs::is_directory(case_work_dir / ".tmp" / name, ec)) out.push_back(name);
+  return out;
+}
+
+CaseActivity case_activity(const fs::path& case_work_dir) {
+  CaseActivity a;
+  const fs::path lock = case_work_dir / ".lock";
+  struct stat st {};
+  if (::stat(lock.c_str(), &st) != 0) return a;
+  // /proc/locks lines: "1: FLOCK  ADVISORY  WRITE 1234 fe:00:10953002 0 EOF"
+  // (device major:minor in hex, inode in decimal); "->" lines are waiters.
+  const std::string dev = fmt::format("{:02x}:{:02x}:{}", major(st.st_dev), minor(st.st_dev), st.st_ino);
+  std::ifstream locks("/proc/locks");
+  for (std::string line; std::getline(locks, line);) {
+    std::istringstream in(line);
+    std::string num, kind, mode, access, pid, where;
+    if (!(in >> num >> kind) || kind == "->") continue;
+    if (in >> mode >> access >> pid >> where && kind == "FLOCK" && where == dev) {
+      a.running = true;
+      break;
+    }
+  }
+  if (!a.running) return a;
+  a.holder = files::read_text(lock);
+  while (!a.holder.empty() && (a.holder.back() == '\n' || a.holder.back() == ' ')) a.holder.pop_back();
+  a.stages = stages_in_progress(case_work_dir);
+  return a;
+}
+
+std::optional<double> cohort_eta(const std::map<std::string, std::vector<double>>& samples,
+                                 const std::vector<std::set<std::string>>& finished, int parallel) {
+  if (samples.empty()) return std::nullopt;
+  std::map<std::string, double> median;
+  for (const auto& [stage, v] : samples)
+    if (!v.empty()) median[stage] = median_of(v);
+  if (median.empty()) return std::nullopt;
+  double work = 0;
+  for (const auto& done : finished)
+    for (const auto& [stage, m] : median)
+      if (!done.count(stage)) work += m;
+  return work / std::max(1, parallel);
+}
+
+std::map<std::string, double> stages_finished_since(const fs::path& manifest_file, const std::string& since) {
+  std::map<std::string, double> out;
+  if (!fs::exists(manifest_file)) return out;
+  pipeline::Manifest m;
+  try {
+    m = pipeline::Manifest::load(manifest_file);
+  } catch (const InputError&) {
+    return out;  // being rewritten elsewhere (a Slurm task on another node): next time
+  }
+  for (const auto& [name, rec] : m.stages())
+    if (rec.status == "ok" && rec.finished >= since) out[name] = rec.duration_s;  // ISO 8601 UTC sorts as text
+  return out;
+}
+
 CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out) {
   const auto case_files = materialize_cases(c);
   const std::vector<std::size_t> todo = selected_cases(c, o.only_cases);
@@ -141,51 +273,70 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
   };
   std::map<pid_t, Running> running;
   std::vector<CaseOutcome> done;  // in completion order
-  std::vector<double> durations;
+  std::map<std::string, std::vector<double>> stage_samples;  // stage -> durations in this cohort run
+  const std::string since = pipeline::utc_now_iso8601();
   const auto t0 = std::chrono::steady_clock::now();
-  struct sigaction sa {}, old_int {}, old_term {};
-  sa.sa_handler = on_cohort_stop;
-  sigemptyset(&sa.sa_mask);
-  g_stop = 0;
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
+  auto manifest_of = [&](std::size_t i) { return c.work_dir / c.cases[i].id / "work" / "manifest.yaml"; };
 
   std::size_t next = 0;
-  while (next < todo.size() || !running.empty()) {
-    while (!g_stop && next < todo.size() && static_cast<int>(running.size()) < slots) {
-      const std::size_t i = todo[next++];
-      const fs::path dir = c.work_dir / c.cases[i].id;
-      pid_t pid = start_case(o.binary, case_files[i], o.run_args, dir / "run.log");
-      running[pid] = {i, std::chrono::steady_clock::now()};
-    }
-    if (running.empty()) break;
-    int status = 0;
-    pid_t pid = ::waitpid(-1, &status, 0);
-    if (pid < 0) {
-      if (errno == EINTR && g_stop)
+  bool stopping = false;
+  {
+    PoolSignals signals;
+    while (true) {
+      while (!g_stop && next < todo.size() && static_cast<int>(running.size()) < slots) {
+        const std::size_t i = todo[next++];
+        const fs::path dir = c.work_dir / c.cases[i].id;
+        const pid_t pid = start_case(o.binary, case_files[i], o.run_args, dir / "run.log", signals.worker_mask());
+        running[pid] = {i, std::chrono::steady_clock::now()};  // still blocked: no signal in between
+      }
+      if (running.empty()) break;
+      if (g_stop && !stopping) {
+        stopping = true;
+        out << fmt::format("stopping: {} running case(s) get SIGTERM (their runners keep finished stages)\n", running.size());
+        out.flush();
         for (auto& [p, r] : running) ::kill(p, SIGTERM);
-      continue;
+      }
+      int status = 0;
+      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+      if (pid == 0) {
+        signals.wait();  // atomically unblocks: a signal sent before this line is pending and wakes it
+        continue;
+      }
+      if (pid < 0) {
+        if (errno == EINTR) continue;
+        throw ComputeError(fmt::format("cohort: waiting for workers failed: {}", std::strerror(errno)));
+      }
+      auto it = running.find(pid);
+      if (it == running.end()) continue;
+      CaseOutcome r = case_outcome(c, c.cases[it->second.index], WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
+                                   std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count());
+      double stage_sum = 0;
+      for (const auto& [stage, dt] : stages_finished_since(manifest_of(it->second.index), since)) {
+        stage_samples[stage].push_back(dt);
+        stage_sum += dt;
+      }
+      // What a case costs besides its stages (start-up, planning, hashing):
+      // counted like a stage that a running case has already paid.
+      stage_samples[kStartup].push_back(std::max(0.0, r.wall_s - stage_sum));
+      running.erase(it);
+      done.push_back(r);
+      // ETA: what the unfinished cases still need, at the median stage times so far.
+      std::vector<std::set<std::string>> finished;
+      for (const auto& [p, rr] : running) {
+        std::set<std::string> s = {kStartup};
+        for (const auto& [stage, dt] : stages_finished_since(manifest_of(rr.index), since)) s.insert(stage);
+        finished.push_back(s);
+      }
+      for (std::size_t k = next; k < todo.size(); ++k) finished.emplace_back();
+      const auto eta = cohort_eta(stage_samples, finished, slots);
+      const int failed = static_cast<int>(std::count_if(done.begin(), done.end(), [](const CaseOutcome& d) { return !d.as_expected(); }));
+      out << fmt::format("[{}/{}] {:<20} {}{}  ({} unexpected, {:.0f} s elapsed, ETA {})\n", done.size(), todo.size(), r.id,
+                         r.status, r.failed_stage.empty() ? "" : " at " + r.failed_stage, failed,
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                         eta ? fmt::format("{:.0f} s", *eta) : std::string("-"));
+      out.flush();
     }
-    auto it = running.find(pid);
-    if (it == running.end()) continue;
-    CaseOutcome r = case_outcome(c, c.cases[it->second.index], WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
-                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count());
-    running.erase(it);
-    durations.push_back(r.wall_s);
-    done.push_back(r);
-    const std::size_t n_done = done.size();
-    std::vector<double> sorted = durations;
-    std::sort(sorted.begin(), sorted.end());
-    const double median = sorted[sorted.size() / 2];
-    const double eta = median * static_cast<double>(todo.size() - n_done) / slots;
-    const int failed = static_cast<int>(std::count_if(done.begin(), done.end(), [](const CaseOutcome& d) { return !d.as_expected(); }));
-    out << fmt::format("[{}/{}] {:<20} {}{}  ({} unexpected, {:.0f} s elapsed, ETA {:.0f} s)\n", n_done, todo.size(), r.id,
-                       r.status, r.failed_stage.empty() ? "" : " at " + r.failed_stage, failed,
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), eta);
-    out.flush();
   }
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
   CohortReport rep;
   rep.cases = done;
   sort_like_cohort(c, rep.cases);
@@ -198,8 +349,12 @@ CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
   CohortTable t;
   std::set<std::string> columns;
   for (const auto& o : r.cases) {
-    std::map<std::string, std::string> row = {{"case", o.id}, {"status", o.status}, {"failed_stage", o.failed_stage},
-                                              {"message", o.message}, {"wall_time_s", fmt::format("{:.3f}", o.wall_s)}};
+    std::map<std::string, std::string> row = {{"case", o.id},
+                                              {"status", o.status},
+                                              {"exit_code", o.exit_code >= 0 ? std::to_string(o.exit_code) : std::string()},
+                                              {"failed_stage", o.failed_stage},
+                                              {"message", o.message},
+                                              {"wall_time_s", fmt::format("{:.3f}", o.wall_s)}};
     for (const auto& stage : all_stage_names()) {
       const fs::path f = c.work_dir / o.id / "work" / stage / "summary.yaml";
       if (!fs::exists(f)) continue;
@@ -218,7 +373,7 @@ CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
     }
     t.rows.push_back(std::move(row));
   }
-  t.columns = {"case", "status", "failed_stage", "message", "wall_time_s"};
+  t.columns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s"};
   t.columns.insert(t.columns.end(), columns.begin(), columns.end());
   return t;
 }

@@ -5,6 +5,7 @@
 #include <iosfwd>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -18,14 +19,16 @@ struct CohortRunOptions {
   std::vector<std::string> run_args;    // passed to each `stentsim run` (--until, --only, --force, --dry-run)
   std::string binary;                   // the stentsim executable
   bool no_wait = false;                 // slurm: submit and return (`cohort status` follows)
+  bool dry_run = false;                 // local: each case prints its plan (run_args has --dry-run);
+                                        // slurm: print what would be submitted, submit nothing
 };
 
 struct CaseOutcome {
   std::string id;
-  std::string status;        // done | failed | failed as expected | succeeded unexpectedly
+  std::string status;        // done | failed | failed as expected | succeeded unexpectedly | interrupted
   std::string failed_stage;  // from the case's manifest
   std::string message;       // last lines of the case's log on failure
-  int exit_code = 0;
+  int exit_code = 0;         // the case's `stentsim run`: its exit status, 128 + signal when killed, -1 unknown (lost)
   double wall_s = 0;
   bool as_expected() const { return status == "done" || status == "failed as expected"; }
 };
@@ -50,10 +53,38 @@ void sort_like_cohort(const CohortConfig& c, std::vector<CaseOutcome>& cases);
 /// Concurrent cases: min(workers, cores / ranks_per_case), at least 1.
 int concurrent_cases(int workers, int ranks_per_case, int cores);
 
+/// Whether a case's runner is at work now, from its work-folder lock
+/// (pipeline/work_lock.hpp: an flock held by the running `stentsim run`,
+/// released by the kernel when it dies; found in /proc/locks, so looking never
+/// takes the lock) and the stages it is running (their temporary output
+/// folders .tmp/<stage>, which exist only while a stage runs). `holder` is the
+/// lock file's text ("pid N on HOST since T"). Local file systems only: a run
+/// on another node (Slurm) shows through squeue instead.
+struct CaseActivity {
+  bool running = false;
+  std::string holder;
+  std::vector<std::string> stages;
+};
+CaseActivity case_activity(const std::filesystem::path& case_work_dir);
+/// The stages with a temporary output folder under case_work_dir/.tmp.
+std::vector<std::string> stages_in_progress(const std::filesystem::path& case_work_dir);
+
+/// ETA from the median stage times so far (issue 10): `samples` holds, per
+/// stage, the durations of the runs that finished since the cohort run began;
+/// each unfinished case still needs every sampled stage it has not finished
+/// (`finished[i]`), at the median time; `parallel` cases run at once.
+/// nullopt before any stage has finished.
+std::optional<double> cohort_eta(const std::map<std::string, std::vector<double>>& samples,
+                                 const std::vector<std::set<std::string>>& finished, int parallel);
+
+/// Reads a case's manifest: the stages that finished ok at or after `since`
+/// (ISO 8601 UTC) with their durations.
+std::map<std::string, double> stages_finished_since(const std::filesystem::path& manifest_file, const std::string& since);
+
 CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out);
 
-/// The cohort summary as a table: fixed columns (case, status, failed_stage,
-/// message, wall_time_s), then "<stage>.<qoi> [unit]" for every QoI any case's
+/// The cohort summary as a table: fixed columns (case, status, exit_code,
+/// failed_stage, message, wall_time_s), then "<stage>.<qoi> [unit]" for every QoI any case's
 /// stage summaries hold, and "<stage>.wall_time_s"; one row per case.
 struct CohortTable {
   std::vector<std::string> columns;

@@ -223,7 +223,7 @@ CaseOutcome lost_outcome(const CohortCase& k, const TaskRecord& t, const std::st
   CaseOutcome r;
   r.id = k.id;
   r.wall_s = wall;
-  r.exit_code = 1;
+  r.exit_code = -1;  // unknown: the task never wrote its exit code
   r.status = "failed";
   r.message = fmt::format("lost: time, memory or node (Slurm task {} {}); Slurm output: {}", t.job, state,
                           tail_of(t.output, 3));
@@ -419,12 +419,17 @@ std::vector<SlurmCaseState> slurm_case_states(const CohortConfig& c) {
   return out;
 }
 
-CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out) {
-  for (const char* tool : {"sbatch", "squeue", "scancel", "scontrol"})
-    if (find_in_path(tool).empty())
-      throw ComputeError(fmt::format("{}: backend slurm: '{}' not found in PATH (install the Debian package "
-                                     "slurm-client, or use backend: local / --backend local)",
-                                     c.file.string(), tool));
+CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_in, std::ostream& out) {
+  // A dry run submits nothing, so it needs no sbatch; the script it shows is
+  // the one a real run would submit (without --dry-run).
+  CohortRunOptions o = o_in;
+  o.run_args.erase(std::remove(o.run_args.begin(), o.run_args.end(), std::string("--dry-run")), o.run_args.end());
+  if (!o.dry_run)
+    for (const char* tool : {"sbatch", "squeue", "scancel", "scontrol"})
+      if (find_in_path(tool).empty())
+        throw ComputeError(fmt::format("{}: backend slurm: '{}' not found in PATH (install the Debian package "
+                                       "slurm-client, or use backend: local / --backend local)",
+                                       c.file.string(), tool));
   const auto case_files = materialize_cases(c);
   const std::vector<std::size_t> todo = selected_cases(c, o.only_cases);
   auto tasks = load_tasks(c);
@@ -434,9 +439,11 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, 
   std::set<std::string> arrays;
   for (const std::size_t i : todo)
     if (auto it = tasks.find(c.cases[i].id); it != tasks.end()) arrays.insert(it->second.array);
-  const auto states = task_states(arrays);
-  const bool always = std::any_of(o.run_args.begin(), o.run_args.end(),
-                                  [](const std::string& a) { return a == "--force" || a == "--dry-run"; });
+  const bool can_query = !o.dry_run || !find_in_path("squeue").empty();
+  if (!can_query && !arrays.empty())
+    out << "dry run: squeue not found, so recorded tasks count as no longer queued\n";
+  const auto states = can_query ? task_states(arrays) : std::map<std::string, std::string>{};
+  const bool always = std::any_of(o.run_args.begin(), o.run_args.end(), [](const std::string& a) { return a == "--force"; });
   std::vector<std::size_t> attach, submit;
   std::vector<CaseOutcome> done;
   for (const std::size_t i : todo) {
@@ -454,6 +461,28 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, 
       }
     }
     submit.push_back(i);
+  }
+
+  if (o.dry_run) {
+    out << fmt::format("cohort {} (dry run, nothing is submitted): {} cases: {} to submit, {} queued or running, {} up to date\n",
+                       c.name, todo.size(), submit.size(), attach.size(), done.size());
+    for (const std::size_t i : attach) out << fmt::format("  {}: would attach to Slurm task {}\n", c.cases[i].id, tasks.at(c.cases[i].id).job);
+    if (!submit.empty()) {
+      std::vector<std::string> ids;
+      for (const std::size_t i : submit) ids.push_back(c.cases[i].id);
+      const fs::path sdir = c.work_dir / "slurm";
+      std::string cmd = "sbatch";
+      for (const auto& a : sbatch_array_arguments(c, ids.size(), sdir)) cmd += " " + sh_quote(a);
+      out << fmt::format("would first submit a one-task probe job (can the compute nodes see {}?), then:\n", c.work_dir.string());
+      out << "  " << cmd << " " << (sdir / "array-<time>-<pid>.sh").string() << "\n";
+      out << "with this script (task i runs case i of the list):\n";
+      std::istringstream script(slurm_array_script(c, ids, o.binary, o.run_args));
+      for (std::string line; std::getline(script, line);) out << "  | " << line << "\n";
+    }
+    out.flush();
+    CohortReport rep;
+    rep.waited = false;
+    return rep;
   }
 
   struct sigaction sa {}, old_int {}, old_term {};
@@ -491,7 +520,16 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, 
   for (const std::size_t i : attach) out << fmt::format("  {}: attached to Slurm task {}\n", c.cases[i].id, tasks.at(c.cases[i].id).job);
   out.flush();
 
+  std::string submitted_at;  // stages finished since then feed the ETA
+  if (!attach.empty()) {
+    // Attached tasks were submitted earlier: their stages count from then.
+    for (const std::size_t i : attach) {
+      const std::string s = tasks.at(c.cases[i].id).submitted;
+      if (submitted_at.empty() || s < submitted_at) submitted_at = s;
+    }
+  }
   if (!submit.empty()) {
+    if (submitted_at.empty()) submitted_at = utc_now();
     try {
       probe(c, o.binary, out);
       const fs::path sdir = c.work_dir / "slurm";
@@ -529,6 +567,10 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, 
   }
 
   CohortReport rep;
+  if (o.no_wait && g_slurm_stop) {  // Ctrl-C while submitting: take back what was submitted
+    cancel(active_tasks(), out);
+    throw Interrupted();
+  }
   if (o.no_wait) {
     rep.waited = false;
     out << fmt::format("not waiting (--no-wait): follow with `stentsim cohort status {}`\n", c.file.string());
@@ -538,6 +580,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, 
   // Wait: pending/running from squeue, done/failed from exit-code files and manifests.
   const std::size_t total = todo.size();
   const auto t0 = std::chrono::steady_clock::now();
+  const std::string since = submitted_at.empty() ? utc_now() : submitted_at;
   // A task seen outside the queue without its exit-code file gets a grace period
   // (a shared file system may show the file late) before it counts as lost.
   const double grace = std::max(2.0, 3 * c.slurm.poll_interval_s);
@@ -573,7 +616,23 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o, 
                            r->status, r->failed_stage.empty() ? "" : " at " + r->failed_stage, t.job, unexpected,
                            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       }
-      const std::string line = fmt::format("slurm: {} pending, {} running, {}/{} finished", pending, running, done.size(), total);
+      // ETA from the median stage times so far (the cases' manifests, written
+      // by `stentsim run` in each task), over the tasks running now.
+      std::map<std::string, std::vector<double>> samples;
+      std::vector<std::set<std::string>> unfinished;
+      for (const auto& f : follow) {
+        const auto stages = stages_finished_since(c.work_dir / c.cases[f.index].id / "work" / "manifest.yaml", since);
+        if (f.finished)
+          for (const auto& [stage, dt] : stages) samples[stage].push_back(dt);
+        else {
+          std::set<std::string> s;
+          for (const auto& [stage, dt] : stages) s.insert(stage);
+          unfinished.push_back(s);
+        }
+      }
+      const auto eta = cohort_eta(samples, unfinished, std::max(1, running));
+      const std::string line = fmt::format("slurm: {} pending, {} running, {}/{} finished, ETA {}", pending, running,
+                                           done.size(), total, eta ? fmt::format("{:.0f} s", *eta) : std::string("-"));
       if (line != last_line && (pending + running) > 0) out << line << "\n";
       last_line = line;
       out.flush();
