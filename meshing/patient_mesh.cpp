@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <numbers>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/log.hpp"
 #include "common/mesh_tags.hpp"
 
@@ -33,6 +35,8 @@ void validate(const PatientMeshOptions& o) {
   need(o.station_spacing > 0, "station_spacing", "must be positive");
   need(o.points_per_section >= 8, "points_per_section", "must be at least 8");
   need(o.end_trim >= 0, "end_trim", "must be non-negative");
+  need(o.min_section_gap_ratio >= 0 && o.min_section_gap_ratio < 1, "min_section_gap_ratio", "must be in [0, 1)");
+  need(o.algorithm_3d == "delaunay" || o.algorithm_3d == "hxt", "algorithm_3d", "must be delaunay or hxt");
 }
 
 Vector3d WallSections::point(std::size_t s, std::size_t k, std::size_t i) const {
@@ -105,17 +109,24 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
   if (o.media_ratio > 0) w.layers.push_back(tags::media);
   if (o.adventitia_ratio > 0) w.layers.push_back(tags::adventitia);
   if (int(w.layers.size()) != nk - 1) throw InputError("mesh: inconsistent layer set");
+  auto at_abscissa = [&](double sv) {
+    const auto it = std::upper_bound(s.begin(), s.end(), sv);
+    const std::size_t j = std::clamp<std::size_t>(std::size_t(it - s.begin()), 1, cp.size() - 1);
+    const double f = std::clamp((sv - s[j - 1]) / std::max(1e-12, s[j] - s[j - 1]), 0.0, 1.0);
+    return Vector3d((1 - f) * cp[j - 1] + f * cp[j]);
+  };
   std::size_t seg = 0, clamped = 0, rays = 0;
   for (int st = 0; st < ns; ++st) {
     const double sa = s.front() + o.end_trim + L * st / (ns - 1);
     while (seg + 2 < cp.size() && s[seg + 1] < sa) ++seg;
     const double a = std::clamp((sa - s[seg]) / std::max(1e-12, s[seg + 1] - s[seg]), 0.0, 1.0);
     const Vector3d x = (1 - a) * cp[seg] + a * cp[seg + 1];
-    // Tangent over a window of about one spacing so the cut planes turn smoothly.
-    std::size_t i0 = seg, i1 = seg + 1;
-    while (i0 > 0 && sa - s[i0] < 0.5 * o.station_spacing) --i0;
-    while (i1 + 1 < cp.size() && s[i1] - sa < 0.5 * o.station_spacing) ++i1;
-    const Vector3d t = (cp[i1] - cp[i0]).normalized();
+    // Tangent: the chord over one spacing centred on the station (points
+    // interpolated on the polyline, so the window is symmetric and on a
+    // circular arc the chord is the exact tangent), so the cut planes turn
+    // smoothly. Clamped at the centerline's ends.
+    const Vector3d t = (at_abscissa(std::min(s.back(), sa + 0.5 * o.station_spacing)) -
+                        at_abscissa(std::max(s.front(), sa - 0.5 * o.station_spacing))).normalized();
     Vector3d n0((1 - a) * ptn_it->second.at(seg, 0) + a * ptn_it->second.at(seg + 1, 0),
                 (1 - a) * ptn_it->second.at(seg, 1) + a * ptn_it->second.at(seg + 1, 1),
                 (1 - a) * ptn_it->second.at(seg, 2) + a * ptn_it->second.at(seg + 1, 2));
@@ -173,6 +184,7 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
     w.radius.push_back(std::move(r));
   }
   w.clamped_fraction = rays ? double(clamped) / double(rays) : 0.0;
+  check_wall_sections(w, o.min_section_gap_ratio);
   return w;
 }
 
@@ -260,6 +272,24 @@ MeshQuality mesh_quality(const MeshData& m) {
   return q;
 }
 
+std::string mesh_fingerprint(const MeshData& m) {
+  // Raw bytes: equal hashes need bitwise equal coordinates, which is what a
+  // reproducible mesher gives (no tolerance hides a moved node).
+  std::string bytes;
+  auto put = [&bytes](const void* p, std::size_t n) { bytes.append(static_cast<const char*>(p), n); };
+  for (const auto& x : m.points) put(x.data(), 3 * sizeof(double));
+  for (auto t : m.cell_types) {
+    const int v = int(t);
+    put(&v, sizeof v);
+  }
+  put(m.connectivity.data(), m.connectivity.size() * sizeof(std::int64_t));
+  for (const char* key : {tags::kLayer, tags::kFaceGroup}) {
+    auto it = m.cell_data.find(key);
+    if (it != m.cell_data.end()) put(it->second.values.data(), it->second.values.size() * sizeof(double));
+  }
+  return files::text_hash(bytes);
+}
+
 void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesystem::path& wall_vtp,
                       const std::filesystem::path& centerline_vtp, const PatientMeshOptions& o,
                       const std::filesystem::path& artery_vtu, const std::filesystem::path& artery_msh,
@@ -295,6 +325,8 @@ void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesys
   summary.set("thinned_layer_ray_fraction", w.clamped_fraction);
   summary.set("meshing_time", secs, "s");
   summary.note("element", o.element);
+  summary.note("algorithm_3d", o.algorithm_3d);
+  summary.note("mesh_fingerprint", mesh_fingerprint(m));
   summary.note("mesh_size_mm", fmt::format("{}", o.size));
   log::info("mesh: {} {} elements, {} nodes, mean edge {:.3f} mm, min scaled Jacobian {:.3f}, max aspect ratio {:.2f}, {:.1f} s",
             tets, o.element, m.points.size(), q.mean_edge_length, q.min_scaled_jacobian, q.max_aspect_ratio, secs);

@@ -26,11 +26,23 @@ struct PatientMeshOptions {
   double station_spacing = 0.5;   // mm between lofted cross-sections
   int points_per_section = 32;    // rays per cross-section
   double end_trim = 0.2;          // mm cut off each centerline end
+  /// Consecutive sections must not meet inside the wall: each section's outer
+  /// contour lies at least this fraction of the spacing beyond the
+  /// neighbouring section's plane (1 on a straight tube, 1 - r/R on the inner
+  /// side of a bend of radius R; 0.1 allows r up to 0.9 R).
+  double min_section_gap_ratio = 0.1;
   /// Corner scaled Jacobian bound (1: regular tet, 0: flat). 0.05: gmsh's
   /// meshes of the thin (0.1 mm) intima keep a few elements between 0.05 and
   /// 0.1 (case2-rca at 0.25 mm: min 0.092); valid, positive-Jacobian elements.
   double min_scaled_jacobian = 0.05;
   double max_aspect_ratio = 50.0;
+  /// gmsh 3D algorithm: "delaunay" (reproducible: the same input gives the
+  /// same nodes and elements, in one process or across processes) or "hxt".
+  /// gmsh 4.8's HXT adapter orders its input nodes by memory address
+  /// (std::set<MVertex*>; gmsh issue 2255, fixed in gmsh 4.12), so repeated
+  /// runs on the same input differed (case2-rca tet10 at 0.25 mm: 118,614 vs
+  /// 118,557 tets in one process).
+  std::string algorithm_3d = "delaunay";
 };
 
 /// Radii of the lumen, the layer interfaces and the outer wall along rays of
@@ -52,6 +64,12 @@ void validate(const PatientMeshOptions& o);
 /// ray misses the lumen or the wall or the wall is inside the lumen.
 WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const MeshData& centerline,
                            const PatientMeshOptions& o);
+
+/// Before lofting (also called by wall_sections and mesh_wall_sections):
+/// InputError naming the section, its arc length and position when (1) an
+/// interface contour's spline folds back or crosses the next one outward, or
+/// (2) consecutive sections meet inside the wall (see min_section_gap_ratio).
+void check_wall_sections(const WallSections& w, double min_gap_ratio);
 
 struct MeshQuality {
   /// Minimum over the tets of the corner scaled Jacobian of the straight-sided
@@ -75,6 +93,10 @@ MeshQuality mesh_quality(const MeshData& m);
 /// gmsh adapter: loft, fragment, mesh. Returns artery MeshData (tets + tagged
 /// boundary faces, outward) and writes `msh` (gmsh 4.1, physical groups).
 MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh);
+
+/// 128-bit hash (32 hex digits) of the node coordinates (bitwise), cell
+/// types, connectivity and the Layer / FaceGroup tags: equal for equal meshes.
+std::string mesh_fingerprint(const MeshData& m);
 
 /// The stage: reads the three files, writes artery.vtu and artery.msh, quality
 /// into `summary`; ComputeError when the quality is below the bounds.

@@ -26,7 +26,10 @@ struct GmshSession {
   GmshSession() {
     gmsh::initialize();
     gmsh::option::setNumber("General.Terminal", 0);
+    // One thread everywhere (1D, 2D and 3D meshing in parallel over
+    // entities would make the result depend on the schedule).
     gmsh::option::setNumber("General.NumThreads", 1);
+    for (const char* k : {"Mesh.MaxNumThreads1D", "Mesh.MaxNumThreads2D", "Mesh.MaxNumThreads3D"}) gmsh::option::setNumber(k, 1);
   }
   ~GmshSession() { gmsh::finalize(); }
 };
@@ -58,6 +61,8 @@ struct SectionLookup {
 }  // namespace
 
 MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh) {
+  validate(o);
+  check_wall_sections(w, o.min_section_gap_ratio);
   GmshSession session;
   namespace occ = gmsh::model::occ;
   gmsh::model::add("artery");
@@ -166,11 +171,15 @@ MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, 
   gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-  // HXT rather than the classic Delaunay: on case2-rca tet10 at 0.25 mm with
-  // per-layer sizes it gave max aspect ratio 3.6 instead of 15 and min scaled
-  // Jacobian 0.092 instead of 0.076, in 42 s CPU instead of 49 (bench_patient_mesh);
-  // raising Mesh.OptimizeThreshold to 0.6 did not help the classic one.
-  gmsh::option::setNumber("Mesh.Algorithm3D", 10);
+  // The classic Delaunay by default: it is reproducible (gmsh orders its
+  // nodes by number and seeds its random perturbation). gmsh 4.8's HXT
+  // adapter collects the surface nodes in a std::set<MVertex*> ordered by
+  // address (gmsh issue 2255, fixed in 4.12), so its meshes change with the
+  // heap layout: case2-rca tet10 at 0.25 mm gave 118,614 and 118,557 tets in
+  // two runs of one process. HXT gave better shapes there (max aspect ratio
+  // 3.6 instead of 15, min scaled Jacobian 0.092 instead of 0.076; raising
+  // Mesh.OptimizeThreshold to 0.6 did not help the classic one).
+  gmsh::option::setNumber("Mesh.Algorithm3D", o.algorithm_3d == "hxt" ? 10 : 1);
   gmsh::option::setNumber("Mesh.Optimize", 1);
   gmsh::option::setNumber("Mesh.ElementOrder", o.element == "tet10" ? 2 : 1);
   gmsh::option::setNumber("Mesh.SecondOrderLinear", 1);  // midside nodes on straight edges: projecting them onto the lofted B-spline faces took > 10 min on case2-rca
