@@ -45,6 +45,10 @@ class BeamLineLoadTerm : public Term {
                    std::vector<std::size_t> elements = {});
   std::string name() const override { return name_; }
   void assemble(const SystemState& state, Assembler& out) override;
+  /// The load per unit reference length at `time` and the elements it acts on
+  /// (for the output's resultant recovery, beam_resultants.hpp).
+  Eigen::Vector3d force_per_length(double time) const { return (scale_ ? scale_(time) : 1.0) * f_; }
+  const std::vector<std::size_t>& elements() const { return elements_; }
 
  private:
   std::string name_;

@@ -1,5 +1,7 @@
 #include "solver/beams/beam_output.hpp"
 
+#include "solver/beams/beam_resultants.hpp"
+
 #include "common/error.hpp"
 
 #include <cmath>
@@ -7,7 +9,8 @@
 
 namespace stentsim::solver::beams {
 
-MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int samples_per_element) {
+MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int samples_per_element,
+                          std::span<const BeamDeadLineLoad> line_loads) {
   if (samples_per_element < 1) throw InputError("beam output: samples_per_element must be >= 1");
   const BeamSection& sec = beam.body().section;
   const double R = sec.radius > 0 ? sec.radius : std::sqrt(sec.area / std::numbers::pi);
@@ -21,7 +24,10 @@ MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int sa
   DataArray &radius = arr("Radius", 1), &d1 = arr("TriadD1", 3), &d2 = arr("TriadD2", 3), &d3 = arr("TriadD3", 3);
   DataArray &axial = arr("AxialForce", 1), &shear = arr("ShearForce", 2), &torsion = arr("TorsionalMoment", 1);
   DataArray &bending = arr("BendingMoment", 1), &stress = arr("OuterFibreStress", 1), &disp = arr("Displacement", 3);
-  // Elasto-plastic sections (App. C): BendingMoment, the plastic history and
+  // Forces (and, for elastic sections, moments) by equilibrium from each
+  // element's end actions (beam_resultants.hpp): smooth along the element and
+  // exact for the discrete solution, unlike C_F Γ of a stiff section.
+  // Elasto-plastic sections (App. C): the moments, the plastic history and
   // Yielding are the committed ones of the nearest Gauss point
   // (BeamTerm::sample; the plastic state exists only at Gauss points), the
   // outer-fibre plastic strain is R·‖Ω_pl‖, and Yielding = 1 where that Gauss
@@ -35,9 +41,14 @@ MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int sa
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(u.size());
   for (std::size_t e = 0; e < beam.body().elements.size(); ++e) {
     std::vector<std::int64_t> ids;
+    const ElementResultants resultants(beam, u, e, line_load_on(line_loads, e));
     for (int k = 0; k <= samples_per_element; ++k) {
       const double xi = -1.0 + 2.0 * k / samples_per_element;
-      const SectionState s = beam.sample(u, e, xi);
+      SectionState s = beam.sample(u, e, xi);
+      Eigen::Vector3d n, mom;
+      resultants.at(xi, n, mom);
+      s.F = s.triad.transpose() * n;  // material components N = Λᵀ n
+      if (!plastic) s.M = s.triad.transpose() * mom;
       const Eigen::Vector3d r0 = beam.sample(zero, e, xi).position;  // reference centerline
       ids.push_back(static_cast<std::int64_t>(m.points.size()));
       m.points.push_back(s.position);
@@ -68,7 +79,10 @@ MeshData beam_output_mesh(const BeamTerm& beam, const Eigen::VectorXd& u, int sa
   }
   m.field_text["units"] = "mm, N, MPa";
   if (plastic) m.field_text["plastic_curvature"] = "material components (d1, d2, d3) of the section frame, 1/mm";
-  m.field_text["beam_resultants"] = "material frame: F = C_F Gamma, M = C_M Omega (Simo-Reissner)";
+  m.field_text["beam_resultants"] =
+      plastic ? "material frame; forces by equilibrium from the element end forces (n' + f = 0), moments the committed "
+                "Gauss-point ones (elasto-plastic return)"
+              : "material frame; by equilibrium from the element end actions (n' + f = 0, m' + r' x n = 0)";
   return m;
 }
 

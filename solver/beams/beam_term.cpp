@@ -235,6 +235,31 @@ SectionState BeamTerm::sample(const Eigen::VectorXd& u, std::size_t e, double xi
   return s;
 }
 
+BeamTerm::InternalForce BeamTerm::internal_force(const Eigen::VectorXd& u, std::size_t e) const {
+  std::array<Eigen::Vector3d, 4> x;
+  std::array<Eigen::Quaterniond, 3> q;
+  gather(u, e, x, q);
+  // the kernel writes a trial history: keep it off the body's own
+  const PlasticBendingHistory* hc = hist_committed_.data() + hist_offset_[e];
+  std::vector<PlasticBendingHistory> scratch(refs_[e].points.size());
+  InternalForce f;
+  f.x = x;
+  auto copy = [&](const auto& R, int nc, int nt) {
+    for (int k = 0; k < nc; ++k) f.force[k] = R.template segment<3>(3 * k);
+    for (int i = 0; i < nt; ++i) f.moment[i] = R.template segment<3>(3 * (nc + i));
+  };
+  if (body_.interpolation == BeamInterpolation::hermite3) {
+    ElementSystem<4, 3> s;
+    element_system<4, 3>(refs_[e], body_.section, x, q, s, hc, scratch.data(), nullptr);
+    copy(s.R, 4, 3);
+  } else {
+    ElementSystem<2, 2> s;
+    element_system<2, 2>(refs_[e], body_.section, x, q, s, hc, scratch.data(), nullptr);
+    copy(s.R, 2, 2);
+  }
+  return f;
+}
+
 std::vector<SectionState> BeamTerm::section_states(const Eigen::VectorXd& u, std::size_t e) const {
   std::array<Eigen::Vector3d, 4> x;
   std::array<Eigen::Quaterniond, 3> q;

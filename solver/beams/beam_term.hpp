@@ -104,7 +104,19 @@ class BeamTerm : public Term {
   /// those of the nearest Gauss point, piecewise constant along the element,
   /// because resultants are only reliable there and the plastic state exists
   /// only there; `yielding` = that point flowed in the last committed step.
+  /// The VTU output writes position, triad and the plastic state from here,
+  /// and forces (elastic sections: moments too) recovered by equilibrium
+  /// (beam_resultants.hpp), which are smooth and far more accurate than F, M here.
   SectionState sample(const Eigen::VectorXd& u, std::size_t e, double xi) const;
+  /// The element's internal force vector at u (gradient of its stored energy,
+  /// no loads; for plastic sections the return from the committed history),
+  /// the input of the equilibrium-based resultant recovery (beam_resultants.hpp).
+  struct InternalForce {
+    std::array<Eigen::Vector3d, 4> x{};      // current centerline vectors (Hermite r_a, t_a, r_b, t_b; Lagrange r_a, r_b)
+    std::array<Eigen::Vector3d, 4> force{};  // their conjugate forces ∫ B'_k n ds
+    std::array<Eigen::Vector3d, 3> moment{};  // conjugates of the spatial virtual rotations of the nodal triads (a, b[, mid])
+  };
+  InternalForce internal_force(const Eigen::VectorXd& u, std::size_t e) const;
   /// Stored (elastic) energy of the body at u and the current triads; for
   /// plastic sections from the return of the committed history.
   double energy(const Eigen::VectorXd& u) const;
