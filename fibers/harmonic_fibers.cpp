@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/QR>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -96,6 +97,30 @@ std::map<int, std::set<std::int64_t>> face_group_nodes(const MeshData& mesh, con
   return nodes;
 }
 
+/// Unit normal at each node of the faces of `groups` (area-weighted mean of
+/// the faces' normals; corner nodes of the faces), keyed by mesh node.
+std::map<std::int64_t, Vec3> group_node_normals(const MeshData& mesh, std::initializer_list<int> groups) {
+  const auto& g = mesh.cell_data.at(tags::kFaceGroup);
+  std::map<std::int64_t, Vec3> n;
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    const auto t = mesh.cell_types[c];
+    if (t != CellType::triangle && t != CellType::quadratic_triangle && t != CellType::quad) continue;
+    const int grp = static_cast<int>(g.at(c));
+    if (std::find(groups.begin(), groups.end(), grp) == groups.end()) continue;
+    const auto v = mesh.cell(c);
+    const int corners = t == CellType::quad ? 4 : 3;
+    auto p = [&](int k) { return mesh.points[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])]; };
+    const Vec3 a = t == CellType::quad ? Vec3(0.5 * (p(2) - p(0)).cross(p(3) - p(1))) : Vec3(0.5 * (p(1) - p(0)).cross(p(2) - p(0)));
+    for (int k = 0; k < corners; ++k) {
+      auto [it, fresh] = n.emplace(v[static_cast<std::size_t>(k)], Vec3::Zero());
+      // Faces of one plane share the orientation up to sign: align before summing.
+      it->second += it->second.dot(a) < 0 ? Vec3(-a) : a;
+    }
+  }
+  for (auto& [k, v] : n) v.normalize();
+  return n;
+}
+
 std::map<std::int64_t, double> dirichlet(const std::set<std::int64_t>& zero, const std::set<std::int64_t>& one,
                                          const char* what, const std::string& source) {
   std::map<std::int64_t, double> d;
@@ -108,24 +133,70 @@ std::map<std::int64_t, double> dirichlet(const std::set<std::int64_t>& zero, con
   return d;
 }
 
-/// Per volume cell, the gradient of `u` at the cell's centroid. For tet4 the
-/// element gradient is constant and only first-order accurate in direction
-/// (it ignores the curvature of the iso-surfaces within the element), so it is
-/// replaced by the mean of the recovered nodal gradients at its corners (each
-/// the volume-weighted mean of the gradients of the tet4 cells around the
-/// node; Zienkiewicz-Zhu averaging), which is second-order on smooth meshes.
-std::vector<Vec3> cell_gradients(const MeshData& mesh, const Eigen::VectorXd& u) {
-  std::vector<Vec3> nodal(mesh.points.size(), Vec3::Zero());
-  std::vector<double> weight(mesh.points.size(), 0.0);
-  std::vector<Vec3> out;
+/// Polynomial-preserving gradient recovery (after Zhang & Naga 2005) for
+/// tet4 cells: at each vertex a least-squares quadratic fit of the nodal
+/// values over its edge neighbours (the second ring added when the first has
+/// too few nodes for a well-posed fit, e.g. at the boundary), whose gradient
+/// at the vertex is the recovered nodal gradient. Exact for quadratic fields,
+/// also at boundary vertices where averaging is one-sided.
+std::vector<Vec3> nodal_gradients_ppr(const MeshData& mesh, const Eigen::VectorXd& u) {
+  const std::size_t np = mesh.points.size();
+  std::vector<std::vector<std::int64_t>> adj(np);
+  static constexpr int kEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
   for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
     if (mesh.cell_types[c] != CellType::tetra) continue;
     const auto n = mesh.cell(c);
-    const auto& p = mesh.points;
-    const double vol = std::abs((p[n[1]] - p[n[0]]).cross(p[n[2]] - p[n[0]]).dot(p[n[3]] - p[n[0]])) / 6;
-    const Vec3 g = centroid_gradient(mesh, c, u);
-    for (auto k : n) nodal[static_cast<std::size_t>(k)] += vol * g, weight[static_cast<std::size_t>(k)] += vol;
+    for (const auto& e : kEdges) {
+      adj[static_cast<std::size_t>(n[e[0]])].push_back(n[e[1]]);
+      adj[static_cast<std::size_t>(n[e[1]])].push_back(n[e[0]]);
+    }
   }
+  for (auto& a : adj) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  }
+  std::vector<Vec3> nodal(np, Vec3::Zero());
+  std::vector<std::int64_t> patch;
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
+  // A full quadratic in 3D has 10 coefficients; a 1-ring of fewer than 14
+  // nodes (boundary vertices) is widened (13 failed on gmsh tubes: 88 deg).
+  constexpr std::size_t min_points = 14;
+  for (std::size_t i = 0; i < np; ++i) {
+    if (adj[i].empty()) continue;
+    patch.assign(adj[i].begin(), adj[i].end());
+    if (patch.size() < min_points) {
+      for (auto j : adj[i])
+        for (auto k : adj[static_cast<std::size_t>(j)])
+          if (static_cast<std::size_t>(k) != i) patch.push_back(k);
+      std::sort(patch.begin(), patch.end());
+      patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+    }
+    const Vec3 x0 = mesh.points[i];
+    double h = 0;
+    for (auto j : patch) h = std::max(h, (mesh.points[static_cast<std::size_t>(j)] - x0).norm());
+    const auto m = static_cast<Eigen::Index>(patch.size()) + 1;
+    A.resize(m, 10);
+    b.resize(m);
+    auto row = [&](Eigen::Index r, std::int64_t p) {
+      const Vec3 d = (mesh.points[static_cast<std::size_t>(p)] - x0) / h;
+      A.row(r) << 1, d.x(), d.y(), d.z(), d.x() * d.x(), d.y() * d.y(), d.z() * d.z(), d.x() * d.y(), d.x() * d.z(), d.y() * d.z();
+      b(r) = u(p);
+    };
+    row(0, static_cast<std::int64_t>(i));
+    for (std::size_t k = 0; k < patch.size(); ++k) row(static_cast<Eigen::Index>(k) + 1, patch[k]);
+    const Eigen::VectorXd coef = A.colPivHouseholderQr().solve(b);
+    nodal[i] = coef.segment<3>(1) / h;
+  }
+  return nodal;
+}
+
+/// Per volume cell, the gradient at its centroid: for tet4 cells the mean of
+/// the recovered nodal gradients at its corners (the element's own constant
+/// gradient is only first-order accurate in direction), for others the
+/// element gradient.
+std::vector<Vec3> cell_gradients(const MeshData& mesh, const Eigen::VectorXd& u, const std::vector<Vec3>& nodal) {
+  std::vector<Vec3> out;
   for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
     if (!is_volume_cell(mesh.cell_types[c])) continue;
     if (mesh.cell_types[c] != CellType::tetra) {
@@ -133,10 +204,22 @@ std::vector<Vec3> cell_gradients(const MeshData& mesh, const Eigen::VectorXd& u)
       continue;
     }
     Vec3 g = Vec3::Zero();
-    for (auto k : mesh.cell(c)) g += nodal[static_cast<std::size_t>(k)] / weight[static_cast<std::size_t>(k)];
+    for (auto k : mesh.cell(c)) g += nodal[static_cast<std::size_t>(k)];
     out.push_back(g / 4);
   }
   return out;
+}
+
+/// Zero-flux faces of a Laplace problem: the exact gradient is tangent to
+/// them, so the recovered gradient at their nodes loses its normal part.
+/// `index` maps mesh nodes to the recovery mesh's (corner mesh) or is empty.
+void impose_zero_flux(std::vector<Vec3>& nodal, const std::map<std::int64_t, Vec3>& normals, const std::vector<std::int64_t>& index) {
+  for (const auto& [node, n] : normals) {
+    const std::int64_t i = index.empty() ? node : index[static_cast<std::size_t>(node)];
+    if (i < 0) continue;
+    auto& g = nodal[static_cast<std::size_t>(i)];
+    g -= g.dot(n) * n;
+  }
 }
 
 /// The tet4 mesh on the corner nodes of the tet10 cells (other volume cells
@@ -183,26 +266,59 @@ CornerMesh corner_mesh(const MeshData& m) {
   return out;
 }
 
+/// A solved Laplace problem: nodal values on the mesh and, per volume cell,
+/// the gradient at its centroid.
+struct Field {
+  LaplaceSolve solve;
+  std::vector<Vec3> grad;
+};
+
 /// Solves one Laplace problem, on the corner mesh when given: Dirichlet values
 /// on midside nodes are dropped there (their corners carry the same value) and
 /// the solution is interpolated linearly along the edges afterwards (exact for
-/// the piecewise-linear field on straight edges). Returns u on `mesh` points.
-LaplaceSolve solve_on(const MeshData& mesh, const CornerMesh* corners, const std::map<std::int64_t, double>& d,
-                      const std::string& solver) {
-  if (!corners) return solve_laplace(mesh, d, solver);
+/// the piecewise-linear field on straight edges). Gradients of the tet4
+/// fields (the corner mesh, or a tet4 mesh) are recovered (PPR) with the
+/// zero-flux condition imposed at the nodes of `zero_flux` (face normals by
+/// mesh node); tet10 and hex8 cells use their own centroid gradient.
+Field solve_field(const MeshData& mesh, const CornerMesh* corners, const std::map<std::int64_t, double>& d,
+                  const std::string& solver, const std::map<std::int64_t, Vec3>& zero_flux) {
+  Field f;
+  if (!corners) {
+    f.solve = solve_laplace(mesh, d, solver);
+    bool linear = false;
+    for (auto t : mesh.cell_types) linear = linear || t == CellType::tetra;
+    std::vector<Vec3> nodal;
+    if (linear) {
+      nodal = nodal_gradients_ppr(mesh, f.solve.u);
+      impose_zero_flux(nodal, zero_flux, {});
+    }
+    f.grad = cell_gradients(mesh, f.solve.u, nodal);
+    return f;
+  }
   std::vector<std::int64_t> index(mesh.points.size(), -1);
   for (std::size_t i = 0; i < corners->full.size(); ++i) index[static_cast<std::size_t>(corners->full[i])] = static_cast<std::int64_t>(i);
   std::map<std::int64_t, double> dc;
   for (const auto& [node, value] : d)
     if (index[static_cast<std::size_t>(node)] >= 0) dc[index[static_cast<std::size_t>(node)]] = value;
-  LaplaceSolve r = solve_laplace(corners->mesh, dc, solver);
+  f.solve = solve_laplace(corners->mesh, dc, solver);
+  std::vector<Vec3> nodal = nodal_gradients_ppr(corners->mesh, f.solve.u);
+  impose_zero_flux(nodal, zero_flux, index);
+  f.grad = cell_gradients(corners->mesh, f.solve.u, nodal);  // corner-mesh cells are the volume cells in order
   Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.points.size()));
-  for (std::size_t i = 0; i < corners->full.size(); ++i) u(corners->full[i]) = r.u(static_cast<Eigen::Index>(i));
+  for (std::size_t i = 0; i < corners->full.size(); ++i) u(corners->full[i]) = f.solve.u(static_cast<Eigen::Index>(i));
   for (const auto& [node, a, b] : corners->midside) u(node) = 0.5 * (u(a) + u(b));
   // A midside node on a tagged face has both corners on it: its value is the boundary value.
   for (const auto& [node, value] : d) u(node) = value;
-  r.u = std::move(u);
-  return r;
+  f.solve.u = std::move(u);
+  return f;
+}
+
+/// How the two Laplace problems were discretized (for fibers.vtu and summary.yaml).
+std::string laplace_method(const HarmonicFiberOptions& o, bool quadratic) {
+  if (!quadratic) return "Laplace problems on the mesh's own elements, tet4 gradients recovered (PPR, zero-flux faces)";
+  if (!o.linear_on_corners) return "tet10: both Laplace problems quadratic";
+  if (o.transmural_on_corners) return "tet10: both Laplace problems linear on the corner nodes, gradients recovered (PPR, zero-flux faces)";
+  return "tet10: transmural problem quadratic, longitudinal linear on the corner nodes with recovered gradients (PPR, zero-flux faces)";
 }
 
 }  // namespace
@@ -279,18 +395,30 @@ HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& center
   const auto t0 = std::chrono::steady_clock::now();
   bool quadratic = false;
   for (auto t : mesh.cell_types) quadratic = quadratic || t == CellType::quadratic_tetra;
+  // tet10: the longitudinal problem (and on request the transmural one) on
+  // the corner nodes. The transmural field sets the radial direction, which
+  // every other direction is projected against, so it gets the quadratic
+  // solve by default; grad l is only blended with the centerline tangent.
+  const bool l_on_corners = quadratic && o.linear_on_corners;
+  const bool t_on_corners = l_on_corners && o.transmural_on_corners;
   std::optional<CornerMesh> corners;
-  if (quadratic && o.linear_on_corners) corners = corner_mesh(mesh);
-  const CornerMesh* cm = corners ? &*corners : nullptr;
-  const LaplaceSolve t = solve_on(mesh, cm, dirichlet(groups.at(tags::endothelium), groups.at(tags::outer_wall), "transmural", source),
-                                  o.linear_solver);
-  const LaplaceSolve l = solve_on(mesh, cm, dirichlet(groups.at(tags::proximal_cut), groups.at(tags::distal_cut), "longitudinal", source),
-                                  o.linear_solver);
+  if (l_on_corners) corners = corner_mesh(mesh);
+  // Zero-flux faces of each problem (the other problem's Dirichlet faces).
+  const auto cut_normals = group_node_normals(mesh, {tags::proximal_cut, tags::distal_cut});
+  const auto wall_normals = group_node_normals(mesh, {tags::endothelium, tags::outer_wall});
+  const Field t = solve_field(mesh, t_on_corners ? &*corners : nullptr,
+                              dirichlet(groups.at(tags::endothelium), groups.at(tags::outer_wall), "transmural", source),
+                              o.linear_solver, cut_normals);
+  const Field l = solve_field(mesh, l_on_corners ? &*corners : nullptr,
+                              dirichlet(groups.at(tags::proximal_cut), groups.at(tags::distal_cut), "longitudinal", source),
+                              o.linear_solver, wall_normals);
   res.laplace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  res.transmural_residual = t.relative_residual;
-  res.longitudinal_residual = l.relative_residual;
-  res.transmural_iterations = t.iterations;
-  res.longitudinal_iterations = l.iterations;
+  res.transmural_residual = t.solve.relative_residual;
+  res.longitudinal_residual = l.solve.relative_residual;
+  res.transmural_iterations = t.solve.iterations;
+  res.longitudinal_iterations = l.solve.iterations;
+  res.transmural_unknowns = static_cast<std::size_t>(t_on_corners ? corners->full.size() : mesh.points.size());
+  res.longitudinal_unknowns = static_cast<std::size_t>(l_on_corners ? corners->full.size() : mesh.points.size());
 
   // Per cell: radial from grad t, the tangent and grad l.
   struct CellFrame {
@@ -299,18 +427,8 @@ HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& center
   std::vector<CellFrame> frames;
   frames.reserve(volume_cells);
   double orientation = 0;  // sum of tangent . grad l: the centerline may run distal -> proximal
-  // On the corner mesh the fields are linear per tet: recovered gradients as
-  // for tet4 (corner-mesh cells are the volume cells in the same order).
-  std::vector<Vec3> grad_t, grad_l;
-  if (cm) {
-    Eigen::VectorXd tc(static_cast<Eigen::Index>(cm->full.size())), lc(tc.size());
-    for (std::size_t i = 0; i < cm->full.size(); ++i) tc(static_cast<Eigen::Index>(i)) = t.u(cm->full[i]), lc(static_cast<Eigen::Index>(i)) = l.u(cm->full[i]);
-    grad_t = cell_gradients(cm->mesh, tc);
-    grad_l = cell_gradients(cm->mesh, lc);
-  } else {
-    grad_t = cell_gradients(mesh, t.u);
-    grad_l = cell_gradients(mesh, l.u);
-  }
+  const std::vector<Vec3>& grad_t = t.grad;
+  const std::vector<Vec3>& grad_l = l.grad;
   for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
     if (!is_volume_cell(mesh.cell_types[c])) continue;
     const Vec3 gt = grad_t[frames.size()], gl = grad_l[frames.size()];
@@ -353,8 +471,8 @@ HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& center
     push(f1, std::cos(a->second) * ec + std::sin(a->second) * el);
     push(f2, std::cos(a->second) * ec - std::sin(a->second) * el);
     layer.values.push_back(lay);
-    tc.values.push_back(centroid_value(mesh, c, t.u));
-    lc.values.push_back(centroid_value(mesh, c, l.u));
+    tc.values.push_back(centroid_value(mesh, c, t.solve.u));
+    lc.values.push_back(centroid_value(mesh, c, l.solve.u));
     out.add_cell(mesh.cell_types[c], mesh.cell(c));
   }
   out.cell_data["Radial"] = std::move(radial);
@@ -365,10 +483,9 @@ HarmonicFiberResult harmonic_fibers(const MeshData& mesh, const MeshData& center
   out.cell_data[tags::kLayer] = std::move(layer);
   out.cell_data["Transmural"] = std::move(tc);
   out.cell_data["LongitudinalCoordinate"] = std::move(lc);
-  out.point_data["Transmural"] = {1, std::vector<double>(t.u.data(), t.u.data() + t.u.size())};
-  out.point_data["LongitudinalCoordinate"] = {1, std::vector<double>(l.u.data(), l.u.data() + l.u.size())};
-  out.field_text["method"] = fmt::format("harmonic lifting (centerline weight {}{})", o.centerline_weight,
-                                         cm ? ", linear Laplace solves on the tet10 corner nodes" : "");
+  out.point_data["Transmural"] = {1, std::vector<double>(t.solve.u.data(), t.solve.u.data() + t.solve.u.size())};
+  out.point_data["LongitudinalCoordinate"] = {1, std::vector<double>(l.solve.u.data(), l.solve.u.data() + l.solve.u.size())};
+  out.field_text["method"] = fmt::format("harmonic lifting (centerline weight {}; {})", o.centerline_weight, laplace_method(o, quadratic));
   res.quality = fiber_quality(out);
   res.quality.tangent_blend_angle_max_deg = blend_max;
   return res;
@@ -393,8 +510,12 @@ void write_harmonic_fibers(const std::string& artery_vtu, const std::string& cen
   summary.set("tangent_vs_grad_l_angle_max", q.tangent_blend_angle_max_deg, "deg");
   summary.set("laplace_relative_residual", std::max(r.transmural_residual, r.longitudinal_residual));
   summary.set("laplace_time", r.laplace_seconds, "s");
-  summary.note("fiber_method", fmt::format("harmonic lifting, centerline weight {}, linear solver {}{}", o.centerline_weight,
-                                           o.linear_solver, o.linear_on_corners ? ", tet10: linear solves on the corner nodes" : ""));
+  summary.note("fiber_method", fmt::format("harmonic lifting, centerline weight {}, linear solver {}; {}", o.centerline_weight,
+                                           o.linear_solver, r.fibers.field_text.at("method")));
+  summary.set("laplace_transmural_unknowns", static_cast<double>(r.transmural_unknowns));
+  summary.set("laplace_longitudinal_unknowns", static_cast<double>(r.longitudinal_unknowns));
+  summary.set("laplace_transmural_iterations", r.transmural_iterations);
+  summary.set("laplace_longitudinal_iterations", r.longitudinal_iterations);
 }
 
 }  // namespace stentsim::fibers

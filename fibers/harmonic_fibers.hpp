@@ -7,7 +7,8 @@
 //     blended with grad l / |grad l| and projected onto the plane normal to radial
 //   circumferential = longitudinal x radial (so (radial, circumferential, longitudinal) is right-handed)
 //   Fiber1/2 = cos(phi) circumferential +/- sin(phi) longitudinal, phi per layer.
-// Frames are evaluated at each volume cell's reference centroid.
+// Frames are evaluated at each volume cell's reference centroid; gradients of
+// linear (tet4) fields are recovered to second order (harmonic_fibers.cpp).
 #include <string>
 
 #include "common/mesh_data.hpp"
@@ -22,18 +23,24 @@ struct HarmonicFiberOptions {
   /// direction (1: tangent only, 0: grad l only). Ours (the paper is silent).
   double centerline_weight = 0.5;
   /// solver/linalg type (gmres_ilu: ILU(1); gmres_amg: scalar SA-AMG; direct).
-  /// On the case2-rca tet10 wall (452,165 nodes, 61k corner nodes) with the
-  /// corner solves: gmres_ilu 15 + 90 iterations, gmres_amg 61 + 52 and slower
-  /// (bench_fibers); the full tet10 problem did not finish in 8 min with either.
-  std::string linear_solver = "gmres_ilu";
-  /// tet10 meshes: solve the two Laplace problems with linear elements on the
-  /// tet10 corner nodes (the tet4 mesh of the same vertices) and interpolate
-  /// linearly to the midside nodes; the frames then use the recovered nodal
-  /// gradients like a tet4 mesh. About 7x fewer unknowns and far fewer matrix
-  /// entries than the quadratic problem; on gmsh tubes its accuracy against
-  /// the analytic fibers is the tet4 one (tests/fibers/test_gmsh_tube_fibers).
-  /// false: the full quadratic (tet10) problem.
+  /// On the quadratic transmural problem of the case2-rca tet10 wall (183,189
+  /// nodes) ILU(1) set-up dominates: gmres_ilu 70 s CPU for both quadratic
+  /// problems against 23 s with gmres_amg (bench_fibers).
+  std::string linear_solver = "gmres_amg";
+  /// tet10 meshes: solve the longitudinal Laplace problem with linear
+  /// elements on the tet10 corner nodes (the tet4 mesh of the same vertices;
+  /// about 7x fewer unknowns) and interpolate linearly to the midside nodes;
+  /// its gradient is recovered (polynomial-preserving recovery with the
+  /// zero-flux condition on the wall faces). grad l only steers the
+  /// longitudinal direction together with the centerline tangent, and l is
+  /// the slow problem for the Krylov solvers (case2-rca tet10: 131 AMG
+  /// iterations quadratic against 38 for t). false: quadratic as well.
   bool linear_on_corners = true;
+  /// With linear_on_corners: the transmural problem on the corner nodes too
+  /// (fastest; the radial direction then has the recovered tet4 accuracy,
+  /// which misses issue 5's 0.5 deg mean on a tube with two tet10 through the
+  /// wall: 0.565 deg). Default: t is solved on all 10 nodes (0.411 deg there).
+  bool transmural_on_corners = false;
 };
 
 /// Figures of merit of a fiber field (recorded in summary.yaml).
@@ -53,6 +60,7 @@ struct HarmonicFiberResult {
   double laplace_seconds = 0;
   double transmural_residual = 0, longitudinal_residual = 0;
   int transmural_iterations = 0, longitudinal_iterations = 0;
+  std::size_t transmural_unknowns = 0, longitudinal_unknowns = 0;
 };
 
 /// `mesh`: volume cells with cell array Layer, boundary faces with FaceGroup

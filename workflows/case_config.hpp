@@ -29,8 +29,8 @@ struct FiberSettings {
   double media_angle = 0.0, intima_angle = 0.0, adventitia_angle = 0.6981317007977318;  // rad (40 deg)
   bool tension_only = false;
   double centerline_weight = 0.5;          // patient: centerline tangent vs grad l (fibers/harmonic_fibers.hpp)
-  std::string linear_solver = "gmres_ilu"; // patient Laplace solves: gmres_ilu | gmres_amg | direct
-  bool laplace_on_corners = true;          // tet10: linear Laplace solves on the corner nodes (fast; tet4 accuracy)
+  std::string linear_solver = "gmres_amg"; // patient Laplace solves: gmres_amg | gmres_ilu | direct
+  bool laplace_on_corners = true;          // tet10: longitudinal problem on the corner nodes (t stays quadratic)
 };
 
 struct SimulationSettings {

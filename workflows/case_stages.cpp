@@ -81,7 +81,7 @@ Stage harmonic_fibers_stage(const CaseConfig& c) {
   s.inputs = {"mesh/artery.vtu", "centerline/centerline.vtp"};
   s.outputs = {"fibers/fibers.vtu"};
   s.config = slice(c, {"fibers"});
-  s.version = "2";  // 2: tet10 Laplace solves on the corner nodes; centerline_weight, linear_solver, laplace_on_corners keys
+  s.version = "3";  // 3: tet10 t quadratic, l on the corners, recovered gradients; 2: corner solves; centerline_weight, linear_solver, laplace_on_corners keys
   fibers::HarmonicFiberOptions o;
   o.angles = {{tags::intima, c.fibers.intima_angle}, {tags::media, c.fibers.media_angle},
               {tags::adventitia, c.fibers.adventitia_angle}};

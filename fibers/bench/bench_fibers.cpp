@@ -1,12 +1,16 @@
 // Benchmark of the harmonic-lifting fiber stage (not a test): a tagged tet10
 // tube of about the size of the paper's Case 2 wall (238,123 nodes), the two
 // Laplace solves and the frame construction, median of several runs per
-// linear solver. Usage: bench_fibers [runs=3] [elements_around=96] [elements_along=63] [solvers=gmres_ilu]
-// or, on a meshed patient wall: bench_fibers artery.vtu centerline.vtp [runs=3] [solvers=gmres_ilu]
+// linear solver, wall and CPU time (the machine is shared: CPU time is the
+// steadier figure). Usage: bench_fibers [runs=3] [elements_around=96] [elements_along=63] [solvers=gmres_amg]
+// or, on a meshed patient wall: bench_fibers artery.vtu centerline.vtp [runs=3] [solvers=gmres_amg]
 // (solvers: comma-separated solver/linalg types; "direct" KLU2 takes minutes at
-// this size; on the full quadratic problem of the case2-rca tet10 wall gmres_ilu
-// did not finish in 8 minutes: the fibers now solve on the corner nodes).
+// this size). BENCH_FIBERS_MODES=default,corners,quadratic (comma-separated)
+// picks the tet10 discretizations: default (t quadratic, l on the corner
+// nodes), corners (both on the corner nodes), quadratic (both quadratic).
 #include <algorithm>
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -18,6 +22,16 @@
 #include "fibers/tagged_tube.hpp"
 
 using namespace stentsim;
+
+namespace {
+/// CPU seconds of this process (user + system): on the shared machine the
+/// wall time depends on the load, the CPU time much less.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -39,31 +53,50 @@ int main(int argc, char** argv) {
   o.angles = {{tags::intima, 0.0}, {tags::media, 0.0}, {tags::adventitia, 40.0 * M_PI / 180}};
   std::vector<std::string> solvers;
   {
-    std::string list = argc > 4 ? argv[4] : "gmres_ilu";
+    std::string list = argc > 4 ? argv[4] : "gmres_amg";
     for (std::size_t p = 0; p != std::string::npos;) {
       const std::size_t q = list.find(',', p);
       solvers.push_back(list.substr(p, q == std::string::npos ? q : q - p));
       p = q == std::string::npos ? q : q + 1;
     }
   }
+  std::vector<std::string> modes;
+  {
+    const char* m = std::getenv("BENCH_FIBERS_MODES");
+    std::string list = m ? m : "default";
+    for (std::size_t p = 0; p != std::string::npos;) {
+      const std::size_t q = list.find(',', p);
+      modes.push_back(list.substr(p, q == std::string::npos ? q : q - p));
+      p = q == std::string::npos ? q : q + 1;
+    }
+  }
+  for (const auto& mode : modes)
   for (const auto& name : solvers) {
+    o.linear_on_corners = mode != "quadratic";
+    o.transmural_on_corners = mode == "corners";
+    std::printf("mode %s\n", mode.c_str());
     const char* solver = name.c_str();
     o.linear_solver = solver;
-    std::vector<double> total, laplace;
+    std::vector<double> total, laplace, cpu;
     for (int r = 0; r < runs; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
+      const double c0 = cpu_seconds();
       const auto res = fibers::harmonic_fibers(mesh, axis, o);
       total.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       laplace.push_back(res.laplace_seconds);
+      cpu.push_back(cpu_seconds() - c0);
       if (r == 0)
-        std::printf("%s: iterations %d + %d, residual %.2e/%.2e, neighbour fiber angle max %.2f deg\n", solver,
-                    res.transmural_iterations, res.longitudinal_iterations, res.transmural_residual,
-                    res.longitudinal_residual, res.quality.max_neighbour_fiber_angle_deg);
+        std::printf("%s: unknowns %zu + %zu, iterations %d + %d, residual %.2e/%.2e, neighbour fiber angle max %.2f deg, "
+                    "t in [%.3g, %.3g], l in [%.3g, %.3g]\n", solver, res.transmural_unknowns, res.longitudinal_unknowns,
+                    res.transmural_iterations, res.longitudinal_iterations, res.transmural_residual, res.longitudinal_residual,
+                    res.quality.max_neighbour_fiber_angle_deg, res.quality.transmural_min, res.quality.transmural_max,
+                    res.quality.longitudinal_min, res.quality.longitudinal_max);
     }
     std::sort(total.begin(), total.end());
     std::sort(laplace.begin(), laplace.end());
-    std::printf("%s: median total %.2f s (Laplace solves %.2f s) over %d runs\n", solver, total[total.size() / 2],
-                laplace[laplace.size() / 2], runs);
+    std::sort(cpu.begin(), cpu.end());
+    std::printf("%s: median total %.2f s wall, %.2f s CPU (Laplace solves %.2f s wall) over %d runs\n", solver,
+                total[total.size() / 2], cpu[cpu.size() / 2], laplace[laplace.size() / 2], runs);
   }
   return 0;
 }

@@ -83,13 +83,15 @@ MeshData gmsh_tube(bool quadratic, double size) {
 
 double deg(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / M_PI; }
 
-void check(bool quadratic, bool corners = false) {
+/// `all_corners`: tet10 with both Laplace problems on the corner nodes (the
+/// fast option); otherwise the defaults (tet10: t quadratic, l on the corners).
+void check(bool quadratic, bool all_corners = false) {
   const MeshData mesh = gmsh_tube(quadratic, quadratic ? 0.2 : 0.15);
   const fibers::LayerAngles angles{{tags::media, 0.0}, {tags::adventitia, 40 * M_PI / 180}};
   fibers::HarmonicFiberOptions o;
   o.angles = angles;
-  o.linear_solver = quadratic ? "gmres_ilu" : "direct";  // both solver paths
-  o.linear_on_corners = corners;  // tet10: the full quadratic problem unless asked
+  if (!quadratic) o.linear_solver = "direct";  // the three solver paths: direct, default AMG, ILU
+  if (all_corners) o.transmural_on_corners = true, o.linear_solver = "gmres_ilu";
   fibers::TaggedTubeSpec axis;
   axis.length = kLength;
   const auto r = fibers::harmonic_fibers(mesh, fibers::tagged_tube_axis(axis), o);
@@ -107,20 +109,27 @@ void check(bool quadratic, bool corners = false) {
   mean /= static_cast<double>(n);
   const auto& q = r.quality;
   std::printf("gmsh %s tube (%zu nodes, %zu cells): mean angle error %.3f deg, max %.3f deg; t in [%.3g, %.3g], "
-              "l in [%.3g, %.3g]; neighbour fiber angle max %.2f deg; Laplace %.2f s\n",
-              quadratic ? (corners ? "tet10 (linear solves on the corners)" : "tet10") : "tet4", mesh.points.size(), a.num_cells(), mean, worst, q.transmural_min,
-              q.transmural_max, q.longitudinal_min, q.longitudinal_max, q.max_neighbour_fiber_angle_deg, r.laplace_seconds);
+              "l in [%.3g, %.3g]; neighbour fiber angle max %.2f deg; Laplace %.2f s (%zu + %zu unknowns)\n",
+              quadratic ? (all_corners ? "tet10 (both problems on the corners)" : "tet10 (defaults)") : "tet4", mesh.points.size(),
+              a.num_cells(), mean, worst, q.transmural_min, q.transmural_max, q.longitudinal_min, q.longitudinal_max,
+              q.max_neighbour_fiber_angle_deg, r.laplace_seconds, r.transmural_unknowns, r.longitudinal_unknowns);
+  // Issue 5's bounds. Measured: tet4 0.124 / 0.711 deg, tet10 defaults 0.062 /
+  // 0.477, tet10 all on corners 0.195 / 1.409 (before the recovery with the
+  // zero-flux condition the corner solves had 0.354 / 2.374, the maximum at
+  // the endothelium-cut edge: grad t tilted along the axis).
   EXPECT_LT(mean, 0.5);
-  // The corner solves have the tet4 accuracy of the tet10 mesh's vertices
-  // (h = 0.2 mm here: max 2.37 deg, above the issue's 2 deg bound that the
-  // quadratic solve meets with 0.48 deg; mean 0.35 deg within 0.5).
-  EXPECT_LT(worst, corners ? 3.0 : 2.0);
+  EXPECT_LT(worst, 2.0);
+  if (quadratic) {
+    EXPECT_EQ(r.transmural_unknowns, all_corners ? r.longitudinal_unknowns : mesh.points.size());
+    EXPECT_LT(r.longitudinal_unknowns, mesh.points.size() / 4);  // corner nodes only
+  }
   EXPECT_LT(q.orthonormality_error, 1e-12);
   EXPECT_NEAR(q.min_handedness, 1, 1e-12);
   // tet4: the discrete maximum principle up to round-off is not guaranteed on
   // an unstructured mesh with obtuse dihedral angles; tet10: none in general.
-  // We check the range overshoots by less than 1 % (tet4) and 2 % (tet10).
-  const double tol = quadratic ? 0.02 : 0.01;
+  // We check the range overshoots by less than 1 % (tet4, linear fields) and
+  // 2 % (a quadratic t).
+  const double tol = quadratic && !all_corners ? 0.02 : 0.01;
   EXPECT_GE(q.transmural_min, -tol);
   EXPECT_LE(q.transmural_max, 1 + tol);
   EXPECT_GE(q.longitudinal_min, -tol);
@@ -129,7 +138,8 @@ void check(bool quadratic, bool corners = false) {
 }  // namespace
 
 TEST(GmshTubeFibers, Tet4MatchesAnalytic) { check(false); }
-TEST(GmshTubeFibers, Tet10MatchesAnalytic) { check(true); }
-// The stage's default on tet10 meshes: linear Laplace solves on the corner
-// nodes (the tet4 mesh of the same vertices), within the same bounds.
-TEST(GmshTubeFibers, Tet10CornerSolvesMatchAnalytic) { check(true, true); }
+// The stage's default on tet10 meshes: t quadratic, l on the corner nodes.
+TEST(GmshTubeFibers, Tet10DefaultsMatchAnalytic) { check(true); }
+// The fast option: both problems on the corner nodes (the tet4 mesh of the
+// same vertices) with recovered gradients, within the same bounds here.
+TEST(GmshTubeFibers, Tet10AllCornerSolvesMatchAnalytic) { check(true, true); }

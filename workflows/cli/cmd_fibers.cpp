@@ -32,7 +32,7 @@ void register_fibers(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--linear-solver", a->solver, "gmres_ilu | gmres_amg | direct | eigen_lu")->capture_default_str();
   sub->add_flag("--quadratic-laplace", a->quadratic,
-                "tet10: solve the Laplace problems on all 10 nodes (more accurate, minutes at patient size) "
+                "tet10: solve the longitudinal Laplace problem on all 10 nodes too (the transmural one always is) "
                 "instead of on the corner nodes");
   on(sub, [a] {
     fibers::HarmonicFiberOptions o;
