@@ -510,8 +510,7 @@ void write_harmonic_fibers(const std::string& artery_vtu, const std::string& cen
   summary.set("tangent_vs_grad_l_angle_max", q.tangent_blend_angle_max_deg, "deg");
   summary.set("laplace_relative_residual", std::max(r.transmural_residual, r.longitudinal_residual));
   summary.set("laplace_time", r.laplace_seconds, "s");
-  summary.note("fiber_method", fmt::format("harmonic lifting, centerline weight {}, linear solver {}; {}", o.centerline_weight,
-                                           o.linear_solver, r.fibers.field_text.at("method")));
+  summary.note("fiber_method", fmt::format("{}, linear solver {}", r.fibers.field_text.at("method"), o.linear_solver));
   summary.set("laplace_transmural_unknowns", static_cast<double>(r.transmural_unknowns));
   summary.set("laplace_longitudinal_unknowns", static_cast<double>(r.longitudinal_unknowns));
   summary.set("laplace_transmural_iterations", r.transmural_iterations);
