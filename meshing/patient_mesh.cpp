@@ -184,7 +184,7 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
     w.radius.push_back(std::move(r));
   }
   w.clamped_fraction = rays ? double(clamped) / double(rays) : 0.0;
-  check_wall_sections(w, o.min_section_gap_ratio);
+  w.min_gap_ratio = check_wall_sections(w, o.min_section_gap_ratio);
   return w;
 }
 
@@ -323,6 +323,7 @@ void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesys
   summary.set("mean_edge_length", q.mean_edge_length, "mm");
   summary.set("sections", double(w.origin.size()));
   summary.set("thinned_layer_ray_fraction", w.clamped_fraction);
+  summary.set("min_section_gap_ratio", w.min_gap_ratio);
   summary.set("meshing_time", secs, "s");
   summary.note("element", o.element);
   summary.note("algorithm_3d", o.algorithm_3d);

@@ -54,6 +54,7 @@ struct WallSections {
   std::vector<std::vector<std::vector<double>>> radius;
   std::vector<int> layers;  // layer between surface k and k+1 (tags::Layer)
   double clamped_fraction = 0;  // rays where media/adventitia shrank to keep min_intima
+  double min_gap_ratio = 1;     // smallest gap between consecutive sections / spacing (check_wall_sections)
   Eigen::Vector3d point(std::size_t s, std::size_t k, std::size_t i) const;
 };
 
@@ -69,7 +70,8 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
 /// InputError naming the section, its arc length and position when (1) an
 /// interface contour's spline folds back or crosses the next one outward, or
 /// (2) consecutive sections meet inside the wall (see min_section_gap_ratio).
-void check_wall_sections(const WallSections& w, double min_gap_ratio);
+/// Returns the smallest gap found (fraction of the spacing; 1 on a straight tube).
+double check_wall_sections(const WallSections& w, double min_gap_ratio);
 
 struct MeshQuality {
   /// Minimum over the tets of the corner scaled Jacobian of the straight-sided

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -82,7 +83,7 @@ std::string surface_name(const WallSections& w, std::size_t k) {
 
 }  // namespace
 
-void check_wall_sections(const WallSections& w, double min_gap_ratio) {
+double check_wall_sections(const WallSections& w, double min_gap_ratio) {
   const std::size_t ns = w.origin.size();
   if (ns < 2 || w.radius.size() != ns) throw InputError("mesh: wall sections: fewer than two sections");
   const std::size_t nk = w.radius[0].size();
@@ -139,6 +140,7 @@ void check_wall_sections(const WallSections& w, double min_gap_ratio) {
   // sections meet on a line; on a bend of radius R (centerline) that line is R
   // from the centerline, so an outer radius r >= R puts it inside the wall (a
   // straight tube has gap = spacing; the bend's inner side has (1 - r/R) of it).
+  double smallest = std::numeric_limits<double>::infinity();
   for (std::size_t s = 0; s + 1 < ns; ++s) {
     const double ds = (w.origin[s + 1] - w.origin[s]).norm();
     const double need = min_gap_ratio * ds;
@@ -155,6 +157,7 @@ void check_wall_sections(const WallSections& w, double min_gap_ratio) {
       const double d = (w.origin[s + 1] - x).dot(w.tangent[s + 1]);
       if (d < worst) worst = d, where = x, which = s;
     }
+    smallest = std::min(smallest, worst / ds);
     if (worst < need) {
       // Local bend radius of the centerline from the turn of the tangent.
       const double turn = std::acos(std::clamp(w.tangent[s].dot(w.tangent[s + 1]), -1.0, 1.0));
@@ -171,6 +174,7 @@ void check_wall_sections(const WallSections& w, double min_gap_ratio) {
           min_gap_ratio, ds, bend, rmax));
     }
   }
+  return smallest;
 }
 
 }  // namespace stentsim::meshing

@@ -69,7 +69,12 @@ TEST(PatientMeshChecks, GapBoundFollowsTheBendRadius) {
   // two sections: r/R = 0.85 passes a 0.1 bound, 0.93 does not, and passes 0.
   auto o = coarse();
   const double rw = 1.7;
-  EXPECT_EQ(section_error({2.0, rw / 0.85, 1.0, 2.0}, 1.0, rw, o), "");
+  const test::BentPath pass{2.0, rw / 0.85, 1.0, 2.0};
+  EXPECT_EQ(section_error(pass, 1.0, rw, o), "");
+  // The smallest gap found is the analytic one of the bend's inner side.
+  const auto w = meshing::wall_sections(test::path_tube(pass, 1.0), test::path_tube(pass, rw), test::path_centerline(pass), o);
+  const double ds = w.abscissa[1] - w.abscissa[0];
+  EXPECT_NEAR(w.min_gap_ratio, (1 - 0.85) * std::cos(0.5 * ds / pass.bend), 0.01);
   EXPECT_NE(section_error({2.0, rw / 0.93, 1.0, 2.0}, 1.0, rw, o), "");
   o.min_section_gap_ratio = 0.0;
   EXPECT_EQ(section_error({2.0, rw / 0.93, 1.0, 2.0}, 1.0, rw, o), "");
