@@ -1,6 +1,8 @@
 #include "common/summary.hpp"
 
 #include <sys/resource.h>
+
+#include <chrono>
 #include <yaml-cpp/yaml.h>
 
 #include <fmt/format.h>
@@ -18,6 +20,7 @@ void Summary::set_text(const std::string& name, const std::string& value) { qoi_
 void Summary::set_run(double wall_time_s, double peak_memory_mb) {
   wall_time_s_ = wall_time_s;
   peak_memory_mb_ = peak_memory_mb;
+  run_set_ = true;
 }
 void Summary::note(const std::string& key, const std::string& value) { notes_[key] = value; }
 
@@ -34,8 +37,8 @@ void Summary::write(const std::filesystem::path& file) const {
     out << YAML::Key << "unit" << YAML::Value << q.unit << YAML::EndMap;
   }
   out << YAML::EndMap;
-  out << YAML::Key << "wall_time_s" << YAML::Value << wall_time_s_;
-  out << YAML::Key << "peak_memory_mb" << YAML::Value << peak_memory_mb_;
+  out << YAML::Key << "wall_time_s" << YAML::Value << (run_set_ ? wall_time_s_ : process_wall_time_s());
+  out << YAML::Key << "peak_memory_mb" << YAML::Value << (run_set_ ? peak_memory_mb_ : peak_memory_mb_self());
   if (!notes_.empty()) {
     out << YAML::Key << "notes" << YAML::Value << YAML::BeginMap;
     for (const auto& [k, v] : notes_) out << YAML::Key << k << YAML::Value << v;
@@ -64,12 +67,21 @@ Summary Summary::read(const std::filesystem::path& file) {
     }
     s.wall_time_s_ = root["wall_time_s"] ? root["wall_time_s"].as<double>() : 0.0;
     s.peak_memory_mb_ = root["peak_memory_mb"] ? root["peak_memory_mb"].as<double>() : 0.0;
+    s.run_set_ = root["wall_time_s"] || root["peak_memory_mb"];
     if (root["notes"])
       for (const auto& kv : root["notes"]) s.notes_[kv.first.as<std::string>()] = kv.second.as<std::string>();
   } catch (const YAML::Exception& e) {
     throw InputError(fmt::format("{}: not a valid summary.yaml: {}", file.string(), e.what()));
   }
   return s;
+}
+
+namespace {
+const auto process_start = std::chrono::steady_clock::now();
+}
+
+double process_wall_time_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - process_start).count();
 }
 
 double peak_memory_mb_self() {

@@ -19,6 +19,10 @@ class Summary {
   void set(const std::string& name, double value, const std::string& unit = "");
   void set(const std::string& name, std::vector<double> value, const std::string& unit = "");
   void set_text(const std::string& name, const std::string& value);
+  /// Wall time and peak memory of the run this summary describes. A summary
+  /// written without it (a stand-alone tool: `stentsim fibers`, `mesh`, ...)
+  /// reports this process's own lifetime and peak memory, so every run's
+  /// summary.yaml carries both (issue 11, DESIGN.md §6).
   void set_run(double wall_time_s, double peak_memory_mb);
   /// Free-form facts about how the result was made (model decisions, counts).
   void note(const std::string& key, const std::string& value);
@@ -35,9 +39,13 @@ class Summary {
   std::map<std::string, Qoi> qoi_;
   std::map<std::string, std::string> notes_;
   double wall_time_s_ = 0, peak_memory_mb_ = 0;
+  bool run_set_ = false;
 };
 
 /// Peak resident memory of this process so far, in MB (from getrusage).
 double peak_memory_mb_self();
+
+/// Seconds since this process started (steady clock, taken at static initialisation).
+double process_wall_time_s();
 
 }  // namespace stentsim

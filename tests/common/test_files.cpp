@@ -72,3 +72,18 @@ TEST(Files, SummaryRoundTrips) {
   EXPECT_DOUBLE_EQ(r.wall_time_s(), 2.5);
   fs::remove(f);
 }
+
+// A stand-alone tool that never calls set_run (`stentsim fibers`, `mesh`)
+// still reports its run: this process's lifetime and peak memory, not 0.
+TEST(Files, SummaryWithoutSetRunReportsThisProcess) {
+  const fs::path f = fs::temp_directory_path() / ("stentsim-summary-run-" + std::to_string(::getpid()) + ".yaml");
+  std::vector<double> touch(4'000'000, 1.0);  // ~30 MB resident, so the peak is clearly nonzero
+  Summary s;
+  s.set("x", touch[123], "mm");
+  s.write(f);
+  const auto r = Summary::read(f);
+  EXPECT_GT(r.wall_time_s(), 0.0);
+  EXPECT_LE(r.wall_time_s(), process_wall_time_s());
+  EXPECT_GT(r.peak_memory_mb(), 30.0);
+  fs::remove(f);
+}
