@@ -56,12 +56,12 @@ int main(int argc, char** argv) {
     const auto q = meshing::mesh_quality(m);
     std::size_t tets = 0;
     for (auto n : q.elements_per_layer) tets += n;
-    std::printf("run %d: %.2f s (CPU %.2f s), %zu %s, %zu nodes (intima %zu, media %zu, adventitia %zu), %zu sections, "
+    std::printf("run %d: %.2f s (CPU %.2f s), %zu %s, %zu nodes (intima %zu, media %zu, adventitia %zu), %zu sections (smallest gap %.3f of the spacing), "
                 "mean edge %.4f mm, min scaled Jacobian %.3f (%s, at %.2f %.2f %.2f), min Jacobian ratio %.3f, "
                 "max aspect ratio %.2f, fingerprint %s\n",
                 r + 1, times.back(), cpu.back(), tets, o.element.c_str(), m.points.size(), q.elements_per_layer[tags::intima],
                 q.elements_per_layer[tags::media], q.elements_per_layer[tags::adventitia], w.origin.size(),
-                q.mean_edge_length, q.min_scaled_jacobian, tags::layer_name(q.worst_sj_layer), q.worst_sj_position.x(),
+                w.min_gap_ratio, q.mean_edge_length, q.min_scaled_jacobian, tags::layer_name(q.worst_sj_layer), q.worst_sj_position.x(),
                 q.worst_sj_position.y(), q.worst_sj_position.z(), q.min_jacobian_ratio, q.max_aspect_ratio,
                 meshing::mesh_fingerprint(m).c_str());
     if (r + 1 == runs && argc > 5 && std::string(argv[5]) != "-") write_vtu(argv[5], m);
