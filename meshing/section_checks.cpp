@@ -165,12 +165,12 @@ double check_wall_sections(const WallSections& w, double min_gap_ratio) {
       double rmax = 0;
       for (double r : w.radius[which][nk - 1]) rmax = std::max(rmax, r);
       throw InputError(fmt::format(
-          "mesh: sections {} and {} (s = {:.2f} and {:.2f} mm along the centerline) overlap inside the wall near "
+          "mesh: sections {} and {} (s = {:.2f} and {:.2f} mm along the centerline) {} inside the wall near "
           "({:.3f}, {:.3f}, {:.3f}): the outer wall of section {} is {:.3f} mm from the other section's plane, "
           "below {:.3f} mm ({} of the {:.3f} mm spacing); the centerline bends with radius ~{:.2f} mm there "
           "against an outer radius up to {:.2f} mm. Smooth the centerline, raise mesh.station_spacing (a longer "
           "tangent window) or choose a smaller ROI that leaves the bend out",
-          s, s + 1, w.abscissa[s], w.abscissa[s + 1], where.x(), where.y(), where.z(), which, worst, need,
+          s, s + 1, w.abscissa[s], w.abscissa[s + 1], worst <= 0 ? "overlap" : "come too close", where.x(), where.y(), where.z(), which, worst, need,
           min_gap_ratio, ds, bend, rmax));
     }
   }

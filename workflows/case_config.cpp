@@ -48,6 +48,8 @@ MeshSettings parse_mesh(ConfigMap m, meshing::GenericArterySpec& generic) {
   s.points_per_section = m.integer("points_per_section", s.points_per_section, Range::between(8, 512));
   s.end_trim = m.quantity("end_trim", units::kLength, s.end_trim, Range::non_negative());
   s.max_aspect_ratio = m.number("max_aspect_ratio", s.max_aspect_ratio, Range::between(1, 1e6));
+  s.min_section_gap_ratio = m.number("min_section_gap_ratio", s.min_section_gap_ratio, Range::between(0, 0.99));
+  s.algorithm_3d = m.choice("algorithm_3d", {"delaunay", "hxt"}, s.algorithm_3d);  // hxt: not reproducible (gmsh 4.8)
   if (s.media_ratio + s.adventitia_ratio >= 0.5) m.fail("adventitia_ratio", "media_ratio + adventitia_ratio must be below 0.5");
   if (!s.intima && s.media_ratio == 0 && s.adventitia_ratio == 0) m.fail("intima", "at least one layer is needed");
   if (auto g = m.optional_map("generic")) {

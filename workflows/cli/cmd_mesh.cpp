@@ -27,6 +27,10 @@ void register_mesh(CLI::App& app) {
   c->add_flag("!--no-intima", a->o.intima, "Media reaches the lumen (no intima)");
   c->add_option("--station-spacing", a->o.station_spacing, "Distance of the lofted cross-sections in mm");
   c->add_option("--min-scaled-jacobian", a->o.min_scaled_jacobian, "Quality bound");
+  c->add_option("--min-section-gap-ratio", a->o.min_section_gap_ratio,
+                "Smallest gap between consecutive sections at the outer wall, as a fraction of their spacing");
+  c->add_option("--algorithm-3d", a->o.algorithm_3d, "gmsh 3D mesher: delaunay (reproducible) or hxt (gmsh 4.8: not reproducible)")
+      ->check(CLI::IsMember({"delaunay", "hxt"}));
   on(c, [a] {
     Summary summary;
     const std::filesystem::path out(a->out);
