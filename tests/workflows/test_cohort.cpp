@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <sstream>
 #include <filesystem>
 #include <string>
 
@@ -307,6 +308,39 @@ TEST(CohortPlots, OnlyNumericQoisAndFailedCasesMarked) {
   fs::remove_all(dir);
 }
 
+// Issue 10: one thread per library inside a cohort. The worker binary here is a
+// script that records the environment it was started with: the local pool must
+// hand every case OMP_NUM_THREADS=1 and VTK's sequential SMP backend (Debian's
+// VTK runs its SMP filters on TBB, which ignores OMP_NUM_THREADS), even when
+// the caller's environment says otherwise.
+TEST_F(Cohort, LocalWorkersRunWithOneThreadPerLibrary) {
+  using namespace stentsim::workflows;
+  const fs::path fake = dir / "fake-stentsim";
+  write_atomic(fake, "#!/bin/sh\nenv > \"$(dirname \"$2\")/worker.env\"\n");
+  fs::permissions(fake, fs::perms::owner_all);
+  const auto c = load_cohort(cohort("  - id: a\n  - id: b\n"));
+  ::setenv("VTK_SMP_BACKEND_IN_USE", "TBB", 1);
+  ::setenv("OMP_NUM_THREADS", "8", 1);
+  CohortRunOptions o;
+  o.binary = fake.string();
+  std::ostringstream out;
+  const auto rep = run_cohort(c, o, out);
+  ::unsetenv("VTK_SMP_BACKEND_IN_USE");
+  ::unsetenv("OMP_NUM_THREADS");
+  ASSERT_EQ(rep.cases.size(), 2u) << out.str();
+  for (const char* id : {"a", "b"}) {
+    const auto env = "\n" + read_text(dir / "cohort.work" / id / "worker.env");
+    EXPECT_NE(env.find("\nOMP_NUM_THREADS=1\n"), std::string::npos) << env;
+    EXPECT_NE(env.find("\nVTK_SMP_BACKEND_IN_USE=Sequential\n"), std::string::npos) << env;
+    EXPECT_EQ(env.find("VTK_SMP_BACKEND_IN_USE=TBB"), std::string::npos) << env;
+    EXPECT_NE(env.find("\nVTK_SMP_MAX_THREADS=1\n"), std::string::npos) << env;
+    EXPECT_NE(env.find("\nHOME="), std::string::npos) << env;  // the rest of the environment is kept
+  }
+  const auto single = single_thread_environment();
+  EXPECT_NE(std::find(single.begin(), single.end(), std::make_pair(std::string("VTK_SMP_BACKEND_IN_USE"), std::string("Sequential"))),
+            single.end());
+}
+
 TEST(CohortSlots, NeverOversubscribeCores) {
   using stentsim::workflows::concurrent_cases;
   EXPECT_EQ(concurrent_cases(4, 1, 2), 2);
@@ -335,6 +369,11 @@ TEST(CohortSlurmScript, ArrayOptionsAndMpiLauncherFromTheCohortFile) {
   EXPECT_NE(s.find("'/opt/st sim' run case.yaml '--until' 'centerline' > run.log"), std::string::npos) << s;
   EXPECT_NE(s.find("mpirun --allow-run-as-root --oversubscribe -np ${SLURM_NTASKS:-2}"), std::string::npos) << s;
   EXPECT_NE(s.find("mv -f .exit_code.tmp exit_code"), std::string::npos) << s;
+  // One thread per library in every task, exported before the case runs.
+  const auto run_at = s.find(" run case.yaml");
+  for (const std::string want : {"export OMP_NUM_THREADS='1'\n", "export VTK_SMP_BACKEND_IN_USE='Sequential'\n",
+                                 "export VTK_SMP_MAX_THREADS='1'\n"})
+    EXPECT_LT(s.find(want), run_at) << want << s;
   // One rank per case: no MPI launcher.
   write_atomic(f, "name: one\ntemplate: patient.yaml\nbackend: slurm\ncases:\n  - id: a\n");
   EXPECT_EQ(stentsim::workflows::slurm_array_script(stentsim::workflows::load_cohort(f), {"a"}, "/x", {}).find("mpirun"),

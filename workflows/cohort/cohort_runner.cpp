@@ -115,6 +115,18 @@ pid_t start_case(const std::string& binary, const fs::path& case_file, const std
   std::vector<char*> argv;  // built before fork: the child only calls async-signal-safe functions
   for (auto& s : argv_s) argv.push_back(s.data());
   argv.push_back(nullptr);
+  // The worker's environment: ours, with one thread per library inside a cohort.
+  const auto single = single_thread_environment();
+  std::vector<std::string> env_s;
+  for (char** e = environ; *e; ++e) {
+    const std::string kv = *e;
+    const std::string key = kv.substr(0, kv.find('='));
+    if (std::none_of(single.begin(), single.end(), [&](const auto& p) { return p.first == key; })) env_s.push_back(kv);
+  }
+  for (const auto& [k, v] : single) env_s.push_back(k + "=" + v);
+  std::vector<char*> envp;
+  for (auto& s : env_s) envp.push_back(s.data());
+  envp.push_back(nullptr);
   const pid_t parent = ::getpid();
   std::fflush(nullptr);
   pid_t pid = ::fork();
@@ -133,10 +145,8 @@ pid_t start_case(const std::string& binary, const fs::path& case_file, const std
       ::dup2(fd, 2);
       ::close(fd);
     }
-    // One thread per library inside a cohort: cases already use every core.
-    ::setenv("OMP_NUM_THREADS", "1", 1);
     sigprocmask(SIG_SETMASK, &worker_mask, nullptr);
-    ::execv(binary.c_str(), argv.data());
+    ::execve(binary.c_str(), argv.data(), envp.data());
     std::perror("cohort: exec of stentsim failed");
     ::_exit(127);
   }
@@ -191,6 +201,11 @@ std::vector<std::size_t> selected_cases(const CohortConfig& c, const std::vector
   for (std::size_t i = 0; i < c.cases.size(); ++i)
     if (only.empty() || std::count(only.begin(), only.end(), c.cases[i].id)) todo.push_back(i);
   return todo;
+}
+
+std::vector<std::pair<std::string, std::string>> single_thread_environment() {
+  return {{"OMP_NUM_THREADS", "1"}, {"OPENBLAS_NUM_THREADS", "1"}, {"VTK_SMP_BACKEND_IN_USE", "Sequential"},
+          {"VTK_SMP_MAX_THREADS", "1"}};
 }
 
 int concurrent_cases(int workers, int ranks_per_case, int cores) {

@@ -342,6 +342,8 @@ std::string slurm_array_script(const CohortConfig& c, const std::vector<std::str
           ? "export STENTSIM_MPI_LAUNCH=\"mpirun --allow-run-as-root --oversubscribe -np ${SLURM_NTASKS:-" +
                 std::to_string(c.ranks_per_case) + "}\"\n"
           : "";
+  std::string threads;  // one thread per library, as for the local workers
+  for (const auto& [k, v] : single_thread_environment()) threads += "export " + k + "=" + sh_quote(v) + "\n";
   // The exit-code file ("<rc> <task id>", temp + rename) is the task's last
   // act: its absence after the task left the queue means the task was lost.
   return fmt::format(
@@ -351,7 +353,7 @@ std::string slurm_array_script(const CohortConfig& c, const std::vector<std::str
       "id=${{cases[$SLURM_ARRAY_TASK_ID]}}\n"
       "task=${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}\n"
       "echo \"stentsim cohort task $task: case $id on $(hostname)\"\n"
-      "export OMP_NUM_THREADS=1\n"
+      "{}"
       "{}"
       "cd {}/\"$id\" || exit 2\n"
       "{} > run.log 2>&1\n"
@@ -359,7 +361,7 @@ std::string slurm_array_script(const CohortConfig& c, const std::vector<std::str
       "echo \"$rc $task\" > .exit_code.tmp && mv -f .exit_code.tmp exit_code\n"
       "echo \"case $id: exit $rc\"\n"
       "exit $rc\n",
-      c.file.string(), cases, mpi, sh_quote(c.work_dir.string()), cmd);
+      c.file.string(), cases, threads, mpi, sh_quote(c.work_dir.string()), cmd);
 }
 
 std::vector<std::string> sbatch_array_arguments(const CohortConfig& c, std::size_t n, const fs::path& output_dir) {
