@@ -156,11 +156,15 @@ int main(int argc, char** argv) {
     const auto t0 = Clock::now();
     // Mid-length inner radius, and the largest fiber stretch sqrt(I4) per layer
     // (I4 = 1 + 2 a.E.a with the cell-mean Green-Lagrange strain).
+    // (inner nodes on the node plane nearest mid-length: an odd NZ has none at L/2).
+    double z_mid = 0;
+    for (const auto& x : body.mesh().points)
+      if (std::abs(x.z() - length / 2) < std::abs(z_mid - length / 2)) z_mid = x.z();
     auto mid_inner_radius = [&] {
       double r_sum = 0;
       int n = 0;
       for (std::size_t i = 0; i < body.num_nodes(); ++i)
-        if (body.mesh().points[i].head<2>().norm() < ri + 1e-9 && std::abs(body.mesh().points[i].z() - length / 2) < 0.3)
+        if (body.mesh().points[i].head<2>().norm() < ri + 1e-9 && std::abs(body.mesh().points[i].z() - z_mid) < 1e-9)
           r_sum += body.position(u, i).head<2>().norm(), ++n;
       return r_sum / n;
     };
