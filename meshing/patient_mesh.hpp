@@ -16,8 +16,12 @@ namespace stentsim::meshing {
 struct PatientMeshOptions {
   std::string element = "tet10";  // tet10 | tet4
   double size = 0.25;             // mm, target edge length (paper: mean 0.25 mm)
-  double min_size_ratio = 0.5;    // local size never below this fraction of `size`
-  int min_elements_per_layer = 1; // through each layer (local size <= thickness / n)
+  /// Floor of the local size as a fraction of `size`. With
+  /// min_elements_per_layer >= 2, a layer whose thickness / n is below it is
+  /// an InputError naming both settings (never a silent clamp); with n = 1 it
+  /// is a floor (one element through holds in any conforming mesh).
+  double min_size_ratio = 0.5;
+  int min_elements_per_layer = 1; // through each layer: local size <= thickness / n (honoured for n >= 2)
   // Holzapfel et al. 2005 ratios of layer thickness to the local outer
   // diameter (0.22 / 2.8 and 0.38 / 2.8); 0 omits the layer. The rest is intima.
   double media_ratio = 0.0786, adventitia_ratio = 0.136;
@@ -73,6 +77,13 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
 /// Returns the smallest gap found (fraction of the spacing; 1 on a straight tube).
 double check_wall_sections(const WallSections& w, double min_gap_ratio);
 
+/// InputError naming the layer, its thickness and position and the settings
+/// mesh.min_elements_per_layer and mesh.min_size_ratio when some layer's
+/// thickness / min_elements_per_layer on a section ray is below
+/// min_size_ratio * size (the two settings conflict; no silent clamp).
+/// Called by mesh_wall_sections before gmsh runs.
+void check_layer_sizing(const WallSections& w, const PatientMeshOptions& o);
+
 struct MeshQuality {
   /// Minimum over the tets of the corner scaled Jacobian of the straight-sided
   /// tet and, for tet10, of the quadratic map's scaled Jacobian at its four
@@ -85,6 +96,9 @@ struct MeshQuality {
   Eigen::Vector3d worst_sj_position = Eigen::Vector3d::Zero();
   int worst_sj_layer = 0;
   std::size_t worst_sj_cell = 0;
+  Eigen::Vector3d worst_ar_position = Eigen::Vector3d::Zero();  // centroid of the tet with the largest aspect ratio
+  int worst_ar_layer = 0;
+  std::size_t worst_ar_cell = 0;
   std::vector<std::size_t> elements_per_layer = std::vector<std::size_t>(4, 0);  // by Layer tag
 };
 

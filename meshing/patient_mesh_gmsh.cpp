@@ -63,6 +63,7 @@ struct SectionLookup {
 MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh) {
   validate(o);
   check_wall_sections(w, o.min_section_gap_ratio);
+  check_layer_sizing(w, o);
   GmshSession session;
   namespace occ = gmsh::model::occ;
   gmsh::model::add("artery");
@@ -148,8 +149,10 @@ MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, 
   }
 
   // Local size, through the thickness: in each layer the target, but at most
-  // that layer's local thickness / min_elements_per_layer, never below
-  // min_size_ratio * size. Sizing every layer by the thinnest one at the ray
+  // that layer's local thickness / min_elements_per_layer, not below
+  // min_size_ratio * size. For n >= 2 check_layer_sizing has rejected the
+  // settings where the floor would bite, so the clamp never drops the count;
+  // for n = 1 it is a floor only (one element through holds anyway). Sizing every layer by the thinnest one at the ray
   // (the first version) refined the whole case2-rca wall to the thin intima's
   // size: 307,840 tet10 at 0.25 mm against the paper's 156,590. A point on an
   // interface (within a quarter of the smallest size) takes the finer of the
@@ -166,7 +169,7 @@ MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, 
       const bool innermost_below = k == 0 && r < lo, outermost_above = k + 2 == nk && r > hi;
       if (inside || innermost_below || outermost_above) h = std::min(h, (hi - lo) / o.min_elements_per_layer);
     }
-    return std::clamp(h, hmin, o.size);
+    return std::clamp(h, hmin, o.size);  // a no-op for n >= 2 (check_layer_sizing; same section radii)
   });
   gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
