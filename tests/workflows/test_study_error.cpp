@@ -77,6 +77,11 @@ TEST(StudyConvergence, RichardsonRecoversKnownOrderAndLimit) {
   EXPECT_FALSE(nr.asymptotic);
   EXPECT_NEAR(nr.observed_order, 3.0, 1e-10);
   EXPECT_NE(nr.message.find("not asymptotic"), std::string::npos);
+  // No theoretical order: never judged against itself, never extrapolated.
+  const Richardson unjudged = richardson(h, f, std::nullopt);
+  EXPECT_FALSE(unjudged.ok);
+  EXPECT_FALSE(unjudged.asymptotic);
+  EXPECT_NE(unjudged.message.find("not judged"), std::string::npos) << unjudged.message;
 }
 
 TEST(StudyConvergence, RichardsonRejectsBadRatiosAndOscillation) {
@@ -121,6 +126,14 @@ TEST(StudyConfigFile, ErrorsNameFileAndKey) {
   expect_error("base: phantom.yaml\nqoi: x\nreference: {type: richardson, knob: a}\n"
                "knobs: [{name: a, key: input.phantom.seed, values: [1, 2]}]\n",
                "Richardson");
+  // A Richardson reference needs the theoretical order of its knob.
+  expect_error("base: phantom.yaml\nqoi: x\nreference: {type: richardson, knob: a}\n"
+               "knobs: [{name: a, key: input.phantom.seed, values: [1, 2, 3], h: [0.4, 0.2, 0.1]}]\n",
+               "knobs.a.theoretical_order");
+  // Per-setting orders name a setting label of another knob.
+  expect_error(head + "knobs: [{name: a, key: input.phantom.seed, values: [1, 2], h: [0.2, 0.1],"
+                      " theoretical_order: {default: 2, curvd: 3}},\n        {name: b, key: input.phantom.preset, values: [x], labels: [curved]}]\n",
+               "'curvd'");
   fs::remove_all(d);
 }
 
@@ -382,4 +395,111 @@ TEST(StudyCli, DryRunEstimatesFromBaseTimeBeforeAnythingRan) {
   EXPECT_NE(est.out.find("~2.0 s"), std::string::npos) << est.out;
   EXPECT_NE(est.out.find("estimated time to run: 6 s (from the study's base_time 2 s)"), std::string::npos) << est.out;
   fs::remove_all(d);
+}
+
+TEST(StudyRunner, QoiMissingFromSummaryIsAFailedRowNamingIt) {
+  // A typo'd QoI: every run succeeds, none writes 'true_min_radios'. The rows
+  // fail with the QoI, the run and "did you mean 'true_min_radius'", the
+  // study exits 1 (and the CLI non-zero), study.md lists the failures.
+  const fs::path d = fresh_dir("qoi_typo");
+  phantom_study(d, "[16]");
+  std::string text = read(d / "study.yaml");
+  text.replace(text.find("qoi: true_min_radius"), 20, "qoi: true_min_radios");
+  write(d / "study.yaml", text);
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out";
+  std::ostringstream log;
+  ErrorStudyResult r;
+  EXPECT_EQ(run_error_study(d / "study.yaml", o, log, &r), 1) << log.str();
+  EXPECT_EQ(r.stats.failed, 2);
+  ASSERT_EQ(r.results.size(), 2u);
+  for (std::size_t i = 0; i < r.results.size(); ++i) {
+    const auto& row = r.results[i];
+    EXPECT_EQ(row.status, "failed");
+    EXPECT_NE(row.message.find("'true_min_radios'"), std::string::npos) << row.message;
+    EXPECT_NE(row.message.find(r.plan.runs[i].key.substr(0, 8)), std::string::npos) << row.message;
+    EXPECT_NE(row.message.find("did you mean 'true_min_radius'"), std::string::npos) << row.message;
+    EXPECT_FALSE(std::isfinite(r.outcome.error[i]));
+  }
+  EXPECT_NE(log.str().find("did not write qoi 'true_min_radios'"), std::string::npos) << log.str();
+  EXPECT_NE(read(o.out_dir / "study.md").find("Failed runs"), std::string::npos);
+  // The runs themselves stay cached: fixing the name needs no re-run.
+  const auto cli = stentsim::testing::run_stentsim("study error " + (d / "study.yaml").string() + " --out " + (d / "out").string());
+  EXPECT_NE(cli.code, 0) << cli.out;
+  EXPECT_NE(cli.out.find("true_min_radios"), std::string::npos) << cli.out;
+  write(d / "study.yaml", read(d / "study.yaml").replace(text.find("true_min_radios"), 15, "true_min_radius"));
+  ErrorStudyResult fixed;
+  EXPECT_EQ(run_error_study(d / "study.yaml", o, log, &fixed), 0) << log.str();
+  EXPECT_EQ(fixed.stats.executed, 0);
+  EXPECT_EQ(fixed.stats.failed, 0);
+  fs::remove_all(d);
+}
+
+namespace {
+// Results for a plan whose QoI along `knob` is f(h) = 1 + h^p, no process run.
+std::vector<RunResult> synthetic_results(const StudyConfig& s, const StudyPlan& plan, const std::string& knob, double p) {
+  std::vector<RunResult> results(plan.runs.size());
+  for (std::size_t i = 0; i < plan.runs.size(); ++i) {
+    results[i].status = "ok";
+    results[i].wall_s = 1.0 + static_cast<double>(i);
+    const auto h = run_h(s, plan.runs[i], knob);
+    const double hh = h ? *h : 0.1;  // the base is the finest setting here
+    results[i].qoi[s.qoi] = {1.0 + std::pow(hh, p)};
+  }
+  return results;
+}
+}  // namespace
+
+TEST(StudyConvergence, RichardsonStudyOutsideTheOrderBandIsNotExtrapolated) {
+  // Observed order 3 against theoretical 1 (band 0.5-1.5): "not asymptotic",
+  // the reference is the finest run (no extrapolation). Against 3: extrapolated to 1.
+  const fs::path d = fresh_dir("band");
+  write(d / "phantom.yaml", "input:\n  phantom: {preset: straight-healthy, circumferential_points: 64}\n");
+  auto study = [&](const std::string& order) {
+    write(d / "study.yaml", "base: phantom.yaml\nqoi: q\nreference: {type: richardson, knob: n}\nerror: absolute\n"
+                            "knobs: [{name: n, key: input.phantom.circumferential_points, values: [16, 32, 64], h: [0.4, 0.2, 0.1],"
+                            " theoretical_order: " + order + "}]\n");
+    return load_study(d / "study.yaml");
+  };
+  const StudyConfig s1 = study("1");
+  const StudyPlan plan = plan_study(s1);
+  ASSERT_EQ(plan.runs.size(), 3u);
+  const StudyOutcome o1 = evaluate_study(s1, plan, synthetic_results(s1, plan, "n", 3.0));
+  EXPECT_NE(o1.reference_note.find("NOT done"), std::string::npos) << o1.reference_note;
+  EXPECT_NE(o1.reference_note.find("not asymptotic"), std::string::npos) << o1.reference_note;
+  ASSERT_EQ(o1.lines.size(), 1u);
+  ASSERT_TRUE(o1.lines[0].richardson.has_value());
+  EXPECT_FALSE(o1.lines[0].richardson->ok);
+  EXPECT_NEAR(o1.lines[0].richardson->observed_order, 3.0, 1e-9);
+  EXPECT_NEAR(o1.reference[0].at(0), 1.001, 1e-12);  // the finest run's value, not the limit 1
+  const StudyConfig s3 = study("3");
+  const StudyOutcome o3 = evaluate_study(s3, plan, synthetic_results(s3, plan, "n", 3.0));
+  EXPECT_NE(o3.reference_note.find("Richardson extrapolation"), std::string::npos) << o3.reference_note;
+  EXPECT_NEAR(o3.reference[0].at(0), 1.0, 1e-9);
+  EXPECT_TRUE(o3.lines[0].richardson->ok);
+  fs::remove_all(d);
+}
+
+TEST(StudyConfigFile, TheoreticalOrderPerSettingJudgesEachGridLine) {
+  // The shipped tube study: tet10-curved lines against 3, the others against 2.
+  const StudyConfig s = load_study(fs::path(STENTSIM_TEST_SOURCE_DIR) / "examples/studies/tube.yaml");
+  const Knob* h = nullptr;
+  for (const auto& k : s.knobs)
+    if (k.name == "h") h = &k;
+  ASSERT_NE(h, nullptr);
+  EXPECT_EQ(theoretical_order_for(s, *h, {}), 2.0);                // base: hex8
+  EXPECT_EQ(theoretical_order_for(s, *h, {{"element", 1}}), 2.0);  // tet10 straight
+  EXPECT_EQ(theoretical_order_for(s, *h, {{"element", 2}}), 3.0);  // tet10-curved
+  const StudyPlan plan = plan_study(s);
+  const StudyOutcome o = evaluate_study(s, plan, synthetic_results(s, plan, "h", 3.0));
+  int curved = 0;
+  for (const auto& line : o.lines)
+    if (line.label.find("tet10-curved") != std::string::npos && line.knob == "h") {
+      ++curved;
+      EXPECT_EQ(line.theoretical_order, 3.0);
+      ASSERT_TRUE(line.richardson.has_value());
+      EXPECT_TRUE(line.richardson->ok) << line.richardson->message;
+    }
+  EXPECT_EQ(curved, 1);
 }

@@ -69,12 +69,16 @@ Richardson richardson(std::vector<double> h, std::vector<double> f, std::optiona
     return r;
   }
   r.observed_order = std::log(e32 / e21) / std::log(r21);
-  const double p_th = theoretical_order.value_or(r.observed_order);
+  if (!theoretical_order) {
+    // Never judged against the observed order itself (that always passes).
+    r.message = fmt::format("not judged: no theoretical_order for this line (observed order {:.3g}); not extrapolated",
+                            r.observed_order);
+    return r;
+  }
+  const double p_th = *theoretical_order;
   r.asymptotic = r.observed_order > 0 && r.observed_order >= 0.5 * p_th && r.observed_order <= 1.5 * p_th;
   if (!r.asymptotic) {
-    r.message = theoretical_order ? fmt::format("not asymptotic: observed order {:.3g} outside 0.5-1.5 x {:.3g}",
-                                                r.observed_order, *theoretical_order)
-                                  : fmt::format("not asymptotic: observed order {:.3g}", r.observed_order);
+    r.message = fmt::format("not asymptotic: observed order {:.3g} outside 0.5-1.5 x {:.3g}", r.observed_order, p_th);
     return r;
   }
   const double rp = std::pow(r21, r.observed_order);

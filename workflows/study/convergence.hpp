@@ -30,8 +30,8 @@ struct Richardson {
 
 /// From three solutions f at sizes h (any order; the three finest are used).
 /// Requires a constant ratio >= 1.5 (within 1 %) and monotone convergence;
-/// otherwise ok = false with the reason. Without a theoretical order the
-/// observed one is accepted when it is positive.
+/// otherwise ok = false with the reason. Without a theoretical order nothing
+/// is judged or extrapolated (ok = false, "not judged").
 Richardson richardson(std::vector<double> h, std::vector<double> f, std::optional<double> theoretical_order);
 
 }  // namespace stentsim::study

@@ -97,6 +97,16 @@ int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostre
   eo.reuse_timings = o.reuse_timings;
   eo.out = &out;
   r.stats = execute_runs(study, r.plan, r.out_dir, eo, r.results);
+  // A successful run without the study's QoI is a failed row (exit 1), never
+  // a silently missing point.
+  const int missing = fail_runs_missing_qoi(study, r.plan, r.results);
+  r.stats.failed += missing;
+  if (missing > 0) {
+    const auto first = std::find_if(r.results.begin(), r.results.end(), [&](const RunResult& x) {
+      return x.status == "failed" && x.message.find("is not in the summary.yaml") != std::string::npos;
+    });
+    out << fmt::format("error: {} of {} runs succeeded but did not write qoi '{}'; first: {}\n", missing, n, study.qoi, first->message);
+  }
   r.outcome = evaluate_study(study, r.plan, r.results);
   r.files = write_report(study, r.plan, r.results, r.outcome, r.out_dir);
   out << fmt::format("{} runs executed, {} cached, {} failed; reference: {}\n", r.stats.executed, r.stats.cached, r.stats.failed,

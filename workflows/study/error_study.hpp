@@ -33,6 +33,8 @@ struct ErrorStudyResult {
 
 /// Runs the study; prints progress and a summary to `out`. Returns the exit
 /// code: 0 when every run succeeded, 1 when some failed (they are in the table).
+/// A run whose summary.yaml lacks the study's `qoi` counts as failed (message
+/// names the QoI, the run and the QoIs present), so a typo'd QoI exits 1.
 /// A dry run only prints the runs with estimated times (result has no files).
 int run_error_study(const std::filesystem::path& study_file, const ErrorStudyOptions& options, std::ostream& out,
                     ErrorStudyResult* result = nullptr);

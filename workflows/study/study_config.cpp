@@ -104,7 +104,29 @@ Knob read_knob(ConfigMap& k, std::set<std::string>& names) {
     for (double h : knob.h)
       if (!(h > 0)) k.fail("h", "mesh sizes must be positive");
   }
-  if (k.has("theoretical_order")) knob.theoretical_order = k.number("theoretical_order", std::nullopt, Range::positive());
+  if (k.has("theoretical_order")) {
+    const YAML::Node t = k.node()["theoretical_order"];
+    if (t.IsMap()) {
+      // Per line: {default: 2, tet10-curved: 3}; the setting labels are checked in load_study.
+      for (const auto& kv : t) {
+        double v = 0;
+        try {
+          v = kv.second.as<double>();
+        } catch (const YAML::Exception&) {
+          k.fail("theoretical_order", fmt::format("'{}': expected a number", kv.first.as<std::string>()));
+        }
+        if (!(v > 0)) k.fail("theoretical_order", fmt::format("'{}': orders must be positive", kv.first.as<std::string>()));
+        const auto key = kv.first.as<std::string>();
+        if (key == "default") knob.theoretical_order = v;
+        else knob.theoretical_order_by_setting[key] = v;
+      }
+      if (knob.theoretical_order_by_setting.empty() && !knob.theoretical_order)
+        k.fail("theoretical_order", "an empty map; give a number or {default: p, <setting label>: p, ...}");
+    } else {
+      knob.theoretical_order = k.number("theoretical_order", std::nullopt, Range::positive());
+    }
+    if (knob.h.empty()) k.fail("theoretical_order", "needs 'h' (the order is in h)");
+  }
   knob.cost_exponent = k.number("cost_exponent", 0.0, Range::non_negative());
   if (knob.cost_exponent > 0 && knob.h.empty()) k.fail("cost_exponent", "needs 'h' (the cost is scaled by h)");
   return knob;
@@ -161,6 +183,33 @@ YAML::Node get_dotted(const YAML::Node& root, const std::string& dotted) {
     node.reset(child);
   }
   return node;
+}
+
+std::optional<double> theoretical_order_for(const StudyConfig& s, const Knob& along, const std::map<std::string, int>& setting) {
+  for (const auto& other : s.knobs) {
+    if (other.name == along.name) continue;
+    std::optional<std::size_t> idx;
+    if (auto it = setting.find(other.name); it != setting.end()) {
+      idx = static_cast<std::size_t>(it->second);
+    } else {
+      // At the base's value: the setting whose values the base has.
+      for (std::size_t j = 0; j < other.values.size() && !idx; ++j) {
+        bool same = true;
+        for (std::size_t q = 0; q < other.keys.size() && same; ++q) {
+          if (other.keys[q] == "@ranks") same = other.values[j][q].as<int>() == s.base_ranks;
+          else {
+            const YAML::Node b = get_dotted(s.base, other.keys[q]);
+            same = b.IsDefined() && YAML::Dump(b) == YAML::Dump(other.values[j][q]);
+          }
+        }
+        if (same) idx = j;
+      }
+    }
+    if (!idx) continue;
+    if (auto t = along.theoretical_order_by_setting.find(other.labels[*idx]); t != along.theoretical_order_by_setting.end())
+      return t->second;
+  }
+  return along.theoretical_order;
 }
 
 StudyConfig load_study(const fs::path& file) {
@@ -270,11 +319,34 @@ StudyConfig load_study(const fs::path& file) {
     }
     if (c.grid.size() < 2) root.fail("grid", "a grid needs at least two knobs");
   }
+  // Per-setting orders must name a setting of another knob (a typo would
+  // silently fall back to the default).
+  for (const auto& k : c.knobs)
+    for (const auto& [label, p] : k.theoretical_order_by_setting) {
+      bool found = false;
+      std::string all;
+      for (const auto& other : c.knobs)
+        if (other.name != k.name)
+          for (const auto& l : other.labels) {
+            found = found || l == label;
+            all += (all.empty() ? "" : ", ") + l;
+          }
+      if (!found)
+        throw InputError(fmt::format("{}: knobs.{}.theoretical_order: '{}' is neither 'default' nor a setting label of another knob "
+                                     "(labels: {})", file.string(), k.name, label, all.empty() ? "none" : all));
+    }
   if (c.reference.type == Reference::Type::richardson) {
     auto it = std::find_if(c.knobs.begin(), c.knobs.end(), [&](const Knob& k) { return k.name == c.reference.knob; });
     if (it == c.knobs.end()) root.fail("reference", fmt::format("reference.knob '{}' is not a knob of this study", c.reference.knob));
     if (it->h.empty() || it->h.size() < 3)
       root.fail("reference", fmt::format("Richardson extrapolation needs knob '{}' to give 'h' for at least three settings", it->name));
+    // Issue 11: outside 0.5-1.5x the theoretical order the study reports "not
+    // asymptotic" and does not extrapolate; without the order nothing is judged.
+    if (!theoretical_order_for(c, *it, {}))
+      throw InputError(fmt::format("{}: knobs.{}.theoretical_order: required with a 'richardson' reference (the observed order is "
+                                   "judged against 0.5-1.5x it before extrapolating); give the discretisation's order in h, "
+                                   "e.g. theoretical_order: 2",
+                                   file.string(), it->name));
   }
   return c;
 }

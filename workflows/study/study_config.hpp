@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,7 +22,13 @@ struct Knob {
   std::vector<std::vector<YAML::Node>> values;   ///< values[setting][key]
   std::vector<std::string> labels;               ///< one per setting
   std::vector<double> h;                         ///< mesh size per setting; empty: not a refinement knob
-  std::optional<double> theoretical_order;       ///< for the "not asymptotic" check
+  /// Theoretical order of the error in h, for the "not asymptotic" check
+  /// (observed order within 0.5..1.5x). `theoretical_order: 2`, or per line
+  /// `theoretical_order: {default: 2, tet10-curved: 3}` whose other keys are
+  /// setting labels of the study's other knobs (the grid line with that
+  /// setting, or the base having it, is judged against that value).
+  std::optional<double> theoretical_order;       ///< the default
+  std::map<std::string, double> theoretical_order_by_setting;
   double cost_exponent = 0;                      ///< dry-run estimate: time ~ (h_ref / h)^exponent
 };
 
@@ -58,6 +65,11 @@ struct StudyConfig {
   /// estimate before anything of the study was measured.
   std::optional<double> base_time_s;
 };
+
+/// The theoretical order along knob `along` for a line whose runs have the
+/// other knobs at `setting` (knob name -> value index; absent: the base's
+/// value, matched against the knob's settings). nullopt when none applies.
+std::optional<double> theoretical_order_for(const StudyConfig& study, const Knob& along, const std::map<std::string, int>& setting);
 
 /// Reads and validates a study file. Throws InputError naming file, line and key.
 StudyConfig load_study(const std::filesystem::path& file);

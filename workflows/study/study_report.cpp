@@ -55,6 +55,41 @@ std::string join(const std::vector<double>& v) {
 
 }  // namespace
 
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+int fail_runs_missing_qoi(const StudyConfig& s, const StudyPlan& plan, std::vector<RunResult>& results) {
+  int marked = 0;
+  for (std::size_t i = 0; i < results.size() && i < plan.runs.size(); ++i) {
+    RunResult& r = results[i];
+    if (r.status != "ok" || r.qoi.count(s.qoi)) continue;
+    std::vector<std::string> names;
+    for (const auto& [name, v] : r.qoi)
+      if (name != kPerRankMemoryQoi) names.push_back(name);
+    std::stable_sort(names.begin(), names.end(),
+                     [&](const std::string& a, const std::string& b) { return edit_distance(a, s.qoi) < edit_distance(b, s.qoi); });
+    std::string hint;
+    if (!names.empty() && edit_distance(names.front(), s.qoi) <= std::max<std::size_t>(2, s.qoi.size() / 3))
+      hint = fmt::format(" (did you mean '{}'?)", names.front());
+    std::string present;
+    for (const auto& n : names) present += (present.empty() ? "" : ", ") + n;
+    r.status = "failed";
+    r.message = fmt::format("{}: qoi '{}' is not in the summary.yaml of run {} ({}){}; its numeric QoIs are: {}", s.file.string(),
+                            s.qoi, plan.runs[i].key.substr(0, 8), plan.runs[i].label, hint, present.empty() ? "none" : present);
+    ++marked;
+  }
+  return marked;
+}
+
 StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const std::vector<RunResult>& results) {
   StudyOutcome o;
   const std::size_t n = plan.runs.size();
@@ -118,7 +153,8 @@ StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const s
         o.reference_note = fmt::format("Richardson along '{}': fewer than three scalar solutions, no reference", k.name);
         break;
       }
-      const Richardson r = richardson(h, f, k.theoretical_order);
+      // The reference line is the one-at-a-time line: the other knobs at the base.
+      const Richardson r = richardson(h, f, theoretical_order_for(s, k, {}));
       double ref = r.extrapolated;
       if (r.ok) {
         o.reference_note = fmt::format("Richardson extrapolation along '{}' (ratio {:.3g}, observed order {:.3g}, GCI fine {:.3g})",
@@ -139,8 +175,9 @@ StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const s
   }
 
   for (const auto& line : plan.lines) {
-    LineSummary ls{line.label, line.knob, {}, {}, {}, {}, std::nullopt, {}, std::nullopt};
+    LineSummary ls{line.label, line.knob, {}, {}, {}, {}, std::nullopt, std::nullopt, {}, std::nullopt};
     const Knob& k = *find_knob(s, line.knob);
+    if (!line.runs.empty()) ls.theoretical_order = theoretical_order_for(s, k, plan.runs[line.runs.front()].setting);
     for (std::size_t j = 0; j < line.runs.size(); ++j) {
       ls.runs.push_back(line.runs[j]);
       ls.h.push_back(k.h.empty() ? kNaN : k.h[static_cast<std::size_t>(line.settings[j])]);
@@ -150,7 +187,7 @@ StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const s
     if (!k.h.empty()) {
       ls.fitted_order = fitted_order(ls.h, ls.error);
       ls.pairwise_orders = pairwise_orders(ls.h, ls.error);
-      if (ls.h.size() >= 3) ls.richardson = richardson(ls.h, ls.value, k.theoretical_order);
+      if (ls.h.size() >= 3) ls.richardson = richardson(ls.h, ls.value, ls.theoretical_order);
     }
     o.lines.push_back(std::move(ls));
   }
@@ -323,11 +360,18 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
                        r.status, r.cached ? " (cached)" : "", num(o.value[i]), num(o.error[i]), num(r.wall_s), num(r.cpu_s),
                        num(r.peak_memory_mb), plan.runs[i].ranks, num(r.load_average), front.count(i) ? "yes" : "");
     }
+    bool any_failed = false;
+    for (std::size_t i = 0; i < plan.runs.size(); ++i)
+      if (results[i].status != "ok") {
+        if (!any_failed) m << "\n## Failed runs\n\n";
+        any_failed = true;
+        m << "- " << plan.runs[i].key.substr(0, 8) << " " << md(plan.runs[i].label) << ": " << md(results[i].message) << "\n";
+      }
     bool any_order = false;
     for (const auto& l : o.lines)
       if (!l.pairwise_orders.empty()) any_order = true;
     if (any_order) {
-      m << "\n## Orders\n\n| line | h | error | pairwise orders | fitted order | Richardson (QoI only) |\n|---|---|---|---|---|---|\n";
+      m << "\n## Orders\n\n| line | h | error | pairwise orders | fitted order | theoretical | Richardson (QoI only) |\n|---|---|---|---|---|---|---|\n";
       for (const auto& l : o.lines) {
         if (l.pairwise_orders.empty()) continue;
         std::string rich = "-";
@@ -335,8 +379,9 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
           rich = l.richardson->ok ? fmt::format("p = {:.3g}, extrapolated {:.8g}, GCI {:.3g}", l.richardson->observed_order,
                                                 l.richardson->extrapolated, l.richardson->gci_fine)
                                   : l.richardson->message;
-        m << fmt::format("| {} | {} | {} | {} | {} | {} |\n", md(l.label), join(l.h), join(l.error), join(l.pairwise_orders),
-                         l.fitted_order ? fmt::format("{:.3f}", *l.fitted_order) : "-", md(rich));
+        m << fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", md(l.label), join(l.h), join(l.error), join(l.pairwise_orders),
+                         l.fitted_order ? fmt::format("{:.3f}", *l.fitted_order) : "-",
+                         l.theoretical_order ? fmt::format("{:.3g}", *l.theoretical_order) : "-", md(rich));
       }
     }
     m << "\n## Cheapest within tolerance\n\n";

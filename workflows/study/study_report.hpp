@@ -19,6 +19,7 @@ struct LineSummary {
   std::string label, knob;
   std::vector<std::size_t> runs;   ///< runs with a value, in the knob's order
   std::vector<double> h, error, value;
+  std::optional<double> theoretical_order;  ///< the knob's for this line (theoretical_order_for)
   std::optional<double> fitted_order;
   std::vector<double> pairwise_orders;
   std::optional<Richardson> richardson;  ///< from the QoI values alone (three finest)
@@ -33,6 +34,17 @@ struct StudyOutcome {
   std::optional<std::size_t> cheapest;  ///< cheapest run with error <= tolerance
   std::string reference_note;      ///< how the reference was obtained
 };
+
+/// A run that succeeded but whose summary.yaml does not hold the study's QoI
+/// (a typo in `qoi:`, or a command that does not compute it) becomes a failed
+/// row whose message names the QoI, the run and the QoIs that are there
+/// (closest name first, "did you mean"). Returns how many runs were marked.
+/// Without this the run would silently drop out of the errors and the study
+/// would exit 0 with an empty report.
+int fail_runs_missing_qoi(const StudyConfig& study, const StudyPlan& plan, std::vector<RunResult>& results);
+
+/// Levenshtein distance, for "did you mean".
+std::size_t edit_distance(const std::string& a, const std::string& b);
 
 /// Errors, orders, front. Throws InputError for a study whose reference does
 /// not fit its QoI (e.g. a relative error against a zero reference).
