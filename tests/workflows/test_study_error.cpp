@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "common/error.hpp"
@@ -502,4 +503,41 @@ TEST(StudyConfigFile, TheoreticalOrderPerSettingJudgesEachGridLine) {
       EXPECT_TRUE(line.richardson->ok) << line.richardson->message;
     }
   EXPECT_EQ(curved, 1);
+}
+
+TEST(StudyConfigFile, ShippedStudiesLoadPlanAndEstimate) {
+  // Every study in examples/studies loads, plans and gives a dry-run estimate
+  // from its base_time; the other YAML files there are some study's base.
+  const fs::path dir = fs::path(STENTSIM_TEST_SOURCE_DIR) / "examples" / "studies";
+  std::vector<fs::path> studies, others;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".yaml") (YAML::LoadFile(e.path().string())["knobs"] ? studies : others).push_back(e.path());
+  EXPECT_GE(studies.size(), 3u);
+  std::set<fs::path> bases;
+  const fs::path out = fresh_dir("shipped");
+  for (const auto& f : studies) {
+    SCOPED_TRACE(f.string());
+    StudyConfig s;
+    ASSERT_NO_THROW(s = load_study(f));
+    bases.insert(fs::weakly_canonical(s.base_file));
+    EXPECT_TRUE(s.base_time_s.has_value()) << "no base_time";
+    StudyPlan plan;
+    ASSERT_NO_THROW(plan = plan_study(s));
+    EXPECT_GE(plan.runs.size(), 3u);
+    for (const auto& k : s.knobs)
+      if (k.h.size() >= 3) {
+        EXPECT_TRUE(theoretical_order_for(s, k, {}).has_value()) << k.name << ": an h series without theoretical_order";
+      }
+    ErrorStudyOptions o;
+    o.binary = STENTSIM_TEST_BINARY;
+    o.dry_run = true;
+    o.out_dir = out / f.stem();
+    std::ostringstream log;
+    ASSERT_EQ(run_error_study(f, o, log), 0) << log.str();
+    EXPECT_NE(log.str().find("from the study's base_time"), std::string::npos) << log.str();
+    EXPECT_EQ(log.str().find("unknown"), std::string::npos) << log.str();
+    EXPECT_FALSE(fs::exists(o.out_dir / "runs"));
+  }
+  for (const auto& f : others) EXPECT_TRUE(bases.count(fs::weakly_canonical(f))) << f << " is neither a study nor a study's base";
+  fs::remove_all(out);
 }
