@@ -71,7 +71,7 @@ class TrilinosSolver : public LinearSolver {
     std::ostringstream o;
     o << "Belos block GMRES (Krylov space " << settings_.krylov_size << ", tol " << settings_.tolerance << ") + ";
     if (settings_.type == "gmres_ilu") o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
-    else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space)";
+    else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space, symmetric Gauss-Seidel)";
     else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node)";
     return o.str();
   }
@@ -248,7 +248,23 @@ class TrilinosSolver : public LinearSolver {
       p.set("multigrid algorithm", std::string("sa"));
       p.set("number of equations", settings_.amg_equations_per_node);
       p.set("coarse: max size", 1000);
-      p.set("smoother: type", std::string("CHEBYSHEV"));
+      if (settings_.amg_equations_per_node == 1) {
+        // Scalar problems (the fibers' Laplace solves): symmetric Gauss-Seidel.
+        // Chebyshev smoothing relies on a power-iteration estimate of the
+        // largest eigenvalue of D^-1 A (10 iterations by default); on
+        // quadratic tets from gmsh's Delaunay mesher (aspect ratio up to ~12)
+        // the few large, element-local eigenvalues are missed, the smoother
+        // amplifies those modes and GMRES stagnated (straight-healthy tet10
+        // 0.25 mm: 3e-6 after 5000 iterations, issue 5). Gauss-Seidel needs
+        // no spectral estimate and is convergent for any SPD matrix; one
+        // forward and one backward sweep keep the V-cycle symmetric.
+        p.set("smoother: type", std::string("RELAXATION"));
+        Teuchos::ParameterList& sp = p.sublist("smoother: params");
+        sp.set("relaxation: type", std::string("Symmetric Gauss-Seidel"));
+        sp.set("relaxation: sweeps", 1);
+      } else {
+        p.set("smoother: type", std::string("CHEBYSHEV"));
+      }
       check_near_null_space(static_cast<GO>(map->getGlobalNumElements()));
       if (modes_.size() > 0) {
         RCP<MV> ns = rcp(new MV(map, static_cast<std::size_t>(modes_.cols())));
