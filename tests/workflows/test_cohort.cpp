@@ -28,6 +28,57 @@ namespace {
 using Result = stentsim::testing::CliResult;
 Result sh(const std::string& args) { return stentsim::testing::run_stentsim(args); }
 
+// cohort_summary.csv as case id -> column -> cell (every cell is quoted; no newlines in cells).
+std::map<std::string, std::map<std::string, std::string>> read_csv(const fs::path& f) {
+  std::istringstream in(read_text(f));
+  auto fields = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::string cur;
+    bool quoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      const char ch = line[i];
+      if (quoted && ch == '"' && i + 1 < line.size() && line[i + 1] == '"') cur += '"', ++i;
+      else if (ch == '"') quoted = !quoted;
+      else if (ch == ',' && !quoted) out.push_back(cur), cur.clear();
+      else cur += ch;
+    }
+    out.push_back(cur);
+    return out;
+  };
+  std::string line;
+  std::getline(in, line);
+  const auto header = fields(line);
+  std::map<std::string, std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    const auto cells = fields(line);
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
+    rows[row["case"]] = row;
+  }
+  return rows;
+}
+
+// `cohort status`: stage -> cell of one case's line (fixed-width columns: the
+// case in 20 characters, then one space and 18 characters per stage).
+std::map<std::string, std::string> status_cells(const std::string& out, const std::string& id) {
+  std::istringstream in(out);
+  std::string header, line, mine;
+  std::getline(in, header);
+  while (std::getline(in, line))
+    if (line.rfind(id + " ", 0) == 0) mine = line;
+  auto trim = [](std::string s) {
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    return s;
+  };
+  std::map<std::string, std::string> cells;
+  for (std::size_t at = 21; at < header.size(); at += 19) {
+    const std::string stage = trim(header.substr(at, 18));
+    if (stage.find(' ') != std::string::npos || stage.empty()) break;  // the Slurm columns
+    cells[stage] = at < mine.size() ? trim(mine.substr(at, 18)) : "";
+  }
+  return cells;
+}
+
 class Cohort : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -59,6 +110,15 @@ TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
   EXPECT_NE(csv.find("\"coarse\",\"done\",\"0\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("mesh.artery_elements"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\"256\""), std::string::npos) << csv;  // 16 x 4 x 4 hex8 for `coarse`
+  // One row per case with its inputs: each override as a column of its own.
+  auto rows = read_csv(dir / "cohort.work/cohort_summary.csv");
+  ASSERT_EQ(rows.size(), 3u) << csv;
+  EXPECT_EQ(rows["coarse"]["override.mesh.generic.elements_around"], "16") << csv;
+  EXPECT_EQ(rows["fine"]["override.mesh.generic.elements_around"], "24") << csv;
+  EXPECT_EQ(rows["other"]["override.mesh.generic.elements_along"], "5") << csv;
+  // Override columns are inputs, not QoIs: no plot of them.
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/plot_override.mesh.generic.elements_around.png"));
+  EXPECT_TRUE(fs::exists(dir / "cohort.work/plot_mesh.artery_elements.png"));
   // Second run: every case's stages are up to date.
   r = sh("cohort run " + f);
   ASSERT_EQ(r.code, 0) << r.out;
@@ -70,6 +130,54 @@ TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("coarse"), std::string::npos);
   EXPECT_EQ(r.out.find("stale"), std::string::npos) << r.out;
+  auto cells = status_cells(r.out, "coarse");
+  EXPECT_EQ(cells["mesh"], "done") << r.out;
+  EXPECT_EQ(cells["fibers"], "done") << r.out;
+  // A changed override makes that case's mesh (and what follows) stale; status
+  // says so without rewriting the case file (looking writes nothing).
+  const fs::path coarse_case = dir / "cohort.work/coarse/case.yaml";
+  const std::string before = read_text(coarse_case);
+  const auto mtime = fs::last_write_time(coarse_case);
+  write_atomic(f, read_text(f).replace(read_text(f).find("elements_around: 16"), 19, "elements_around: 18"));
+  r = sh("cohort status " + f);
+  EXPECT_EQ(r.code, 0) << r.out;
+  cells = status_cells(r.out, "coarse");
+  EXPECT_EQ(cells["mesh"], "stale") << r.out;
+  EXPECT_EQ(cells["fibers"], "stale") << r.out;
+  EXPECT_EQ(status_cells(r.out, "fine")["mesh"], "done") << r.out;
+  EXPECT_EQ(read_text(coarse_case), before);
+  EXPECT_EQ(fs::last_write_time(coarse_case), mtime);
+}
+
+// `cohort status` before any run creates no work folder.
+TEST_F(Cohort, StatusWritesNothing) {
+  const auto f = cohort("  - id: a\n  - id: b\n");
+  const auto r = sh("cohort status " + f);
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("a "), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "cohort.work")) << r.out;
+}
+
+// A misspelt stage on the command line stops before anything runs (exit 2,
+// "did you mean"), and leaves the cohort summary of the last run as it was.
+TEST_F(Cohort, MisspeltStageStopsBeforeAnythingRuns) {
+  const auto f = cohort("  - id: a\n  - id: b\n");
+  auto r = sh("cohort run " + f + " --cases a --until mesh");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string summary = read_text(dir / "cohort.work/cohort_summary.csv");
+  for (const auto& [args, hint] : std::vector<std::pair<std::string, std::string>>{
+           {"--until mesj", "--until 'mesj' is not a stage of case 'a'"},
+           {"--only fibres", "did you mean 'fibers'?"},
+           {"--force mesh_", "--force 'mesh_' is not a stage of case 'a'"},
+           {"--cases b --until fibres", "is not a stage of case 'b'"}}) {
+    r = sh("cohort run " + f + " " + args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(hint), std::string::npos) << args << "\n" << r.out;
+  }
+  EXPECT_NE(r.out.find("(its stages: "), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/b/work"));
+  EXPECT_FALSE(fs::exists(dir / "cohort.work/a/work/fibers"));
+  EXPECT_EQ(read_text(dir / "cohort.work/cohort_summary.csv"), summary);
 }
 
 TEST_F(Cohort, SelectsCasesAndPassesRunnerOptions) {
@@ -79,6 +187,33 @@ TEST_F(Cohort, SelectsCasesAndPassesRunnerOptions) {
   EXPECT_FALSE(fs::exists(dir / "cohort.work/a/work/manifest.yaml"));
   EXPECT_TRUE(fs::exists(dir / "cohort.work/b/work/mesh/artery.vtu"));
   EXPECT_FALSE(fs::exists(dir / "cohort.work/b/work/fibers"));
+  // The summary keeps one row per case of the cohort: `a` has not run yet.
+  const fs::path csv = dir / "cohort.work/cohort_summary.csv";
+  auto rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 2u) << read_text(csv);
+  EXPECT_EQ(rows["a"]["status"], "not run") << read_text(csv);
+  EXPECT_EQ(rows["b"]["status"], "done") << read_text(csv);
+  const std::string b_wall = rows["b"]["wall_time_s"];
+  EXPECT_NE(b_wall, "0.000");
+  // Running `a` alone keeps `b`'s row from the previous summary, with its QoIs.
+  r = sh("cohort run " + f + " --cases a --until mesh --workers 1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("1 cases: 1 as expected"), std::string::npos) << r.out;  // counts this run's cases only
+  rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 2u) << read_text(csv);
+  EXPECT_EQ(rows["a"]["status"], "done") << read_text(csv);
+  EXPECT_EQ(rows["b"]["status"], "done") << read_text(csv);
+  EXPECT_EQ(rows["b"]["wall_time_s"], b_wall) << read_text(csv);
+  EXPECT_FALSE(rows["b"]["mesh.artery_elements"].empty()) << read_text(csv);
+  EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.md").find("| b | done |"), std::string::npos);
+  // Without a previous summary, a left-out case's row comes from its manifest.
+  fs::remove(csv);
+  r = sh("cohort run " + f + " --cases a --until mesh --workers 1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 2u) << read_text(csv);
+  EXPECT_EQ(rows["b"]["status"], "done") << read_text(csv);
+  EXPECT_FALSE(rows["b"]["mesh.artery_elements"].empty()) << read_text(csv);
   r = sh("cohort run " + f + " --cases nope");
   EXPECT_EQ(r.code, 2) << r.out;
 }
@@ -188,6 +323,18 @@ TEST_F(Cohort, CasesFromAGlobOfStlFiles) {
     EXPECT_NE(csv.find("\"" + std::string(names[i]) + "\",\"done\",\"0\""), std::string::npos) << csv;
   }
   EXPECT_NE(csv.find("\"phantom\",\"done\""), std::string::npos) << csv;
+  // The input file of each case, by name, in its override column and its inputs.
+  auto rows = read_csv(dir / "stl.work/cohort_summary.csv");
+  ASSERT_EQ(rows.size(), 4u) << csv;
+  for (int i = 0; i < 3; ++i) {
+    const std::string stl = std::string(names[i]) + ".stl";
+    EXPECT_EQ(rows[names[i]]["override.input.surface.lumen"], stl) << csv;
+    EXPECT_EQ(rows[names[i]]["override.input.surface.units"], "mm") << csv;
+    EXPECT_EQ(rows[names[i]]["override.input.phantom"], "null") << csv;
+    EXPECT_NE(rows[names[i]]["inputs"].find("surface.lumen=" + stl), std::string::npos) << csv;
+  }
+  EXPECT_EQ(rows["phantom"]["override.input.surface.lumen"], "") << csv;
+  EXPECT_NE(rows["phantom"]["inputs"].find("phantom.preset=straight-healthy"), std::string::npos) << csv;
   // An id that a glob file repeats, and a glob that matches nothing: errors before anything runs.
   write_atomic(f, "template: patient.yaml\ncases:\n  - id: p02\n"
                   "cases_from: [{glob: scans/*.stl, key: input.surface.lumen, overrides: {input: {phantom: null}}}]\n");
@@ -271,6 +418,14 @@ TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   EXPECT_NE(csv.find("\"severe\",\"failed as expected\",\"1\",\"placement\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("\"rca-seed1\",\"done\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("placement.placement_min_clearance [mm]"), std::string::npos) << csv;
+  // One row per case of the cohort (the four not selected have not run), and
+  // the expected failure shows as such in `cohort status`.
+  EXPECT_EQ(read_csv(dir / "cohort.work/cohort_summary.csv").size(), 6u) << csv;
+  r = sh("cohort status " + f);
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(status_cells(r.out, "severe")["placement"], "failed (expected)") << r.out;
+  EXPECT_EQ(status_cells(r.out, "severe")["centerline"], "done") << r.out;
+  EXPECT_EQ(status_cells(r.out, "rca-seed1")["placement"], "done") << r.out;
   // A PNG per numeric QoI beside the CSV, and the Markdown summary.
   const auto png = read_text(dir / "cohort.work/plot_centerline.stenosis_percent_diameter.png");
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -13,6 +14,7 @@
 #include "workflows/cli/commands.hpp"
 #include "workflows/cohort/cohort_runner.hpp"
 #include "workflows/cohort/cohort_slurm.hpp"
+#include "workflows/study/study_report.hpp"
 #include "workflows/version.hpp"
 
 namespace stentsim::cli {
@@ -37,24 +39,48 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
+/// Stage names given on the command line (--until, --only, --force STAGE),
+/// checked against every selected case's plan before anything runs: a
+/// misspelt stage would otherwise start every case, fail each one and
+/// overwrite the cohort summary. InputError (exit 2) with "did you mean".
+void check_stage_names(const workflows::CohortConfig& c, const std::vector<std::string>& only_cases,
+                       const std::vector<std::pair<std::string, std::string>>& given) {
+  for (const auto i : workflows::selected_cases(c, only_cases)) {
+    const auto& k = c.cases[i];
+    for (const auto& [option, stage] : given) {
+      if (std::find(k.stages.begin(), k.stages.end(), stage) != k.stages.end()) continue;
+      std::string closest, list;
+      for (const auto& s : k.stages) {
+        list += (list.empty() ? "" : ", ") + s;
+        if (closest.empty() || study::edit_distance(s, stage) < study::edit_distance(closest, stage)) closest = s;
+      }
+      const bool near = !closest.empty() && study::edit_distance(closest, stage) <= std::max<std::size_t>(2, stage.size() / 3);
+      throw InputError(fmt::format("{}: {} '{}' is not a stage of case '{}' (its stages: {}){}", c.file.string(), option, stage,
+                                   k.id, list, near ? fmt::format("; did you mean '{}'?", closest) : std::string()));
+    }
+  }
+}
+
 int cohort_status(const std::string& file) {
   const auto c = workflows::load_cohort(file);
-  const auto case_files = workflows::materialize_cases(c);
+  // Looking writes nothing: the case files are not (re)materialized here.
+  constexpr int kCell = 18;  // fits "failed (expected)"
   std::cout << fmt::format("{:<20}", "case");
   // Slurm: the task of each case and where it stands (squeue for pending/running).
   std::optional<std::vector<workflows::SlurmCaseState>> slurm;
   if (workflows::has_slurm_jobs(c)) slurm = workflows::slurm_case_states(c);
-  for (const auto& s : workflows::all_stage_names()) std::cout << fmt::format(" {:<12}", s);
+  for (const auto& s : workflows::all_stage_names()) std::cout << fmt::format(" {:<{}}", s, kCell);
   if (slurm) std::cout << fmt::format(" {:<12} {}", "slurm task", "slurm state");
   std::cout << "\n";
   std::vector<std::string> running_notes;
   for (std::size_t i = 0; i < c.cases.size(); ++i) {
-    const auto cc = workflows::load_case(case_files[i]);
+    const auto cc = workflows::cohort_case_config(c, c.cases[i]);
     pipeline::Runner r(pipeline::Plan(workflows::stages_for(cc), cc.work_dir), kVersion);
     std::map<std::string, std::string> state;
+    const auto& expect = c.cases[i].expect_failure;
     for (const auto& st : r.status())
       state[st.name] = st.state == pipeline::StageState::up_to_date ? "done"
-                       : st.state == pipeline::StageState::failed  ? "failed"
+                       : st.state == pipeline::StageState::failed  ? (expect && *expect == st.name ? "failed (expected)" : "failed")
                        : st.state == pipeline::StageState::stale   ? "stale"
                                                                    : "-";
     // Running: a local runner holds the case's work-folder lock; a Slurm task
@@ -68,7 +94,7 @@ int cohort_status(const std::string& file) {
     }
     std::cout << fmt::format("{:<20}", c.cases[i].id);
     for (const auto& s : workflows::all_stage_names())
-      std::cout << fmt::format(" {:<12}", state.count(s) ? state[s] : "");
+      std::cout << fmt::format(" {:<{}}", state.count(s) ? state[s] : "", kCell);
     if (slurm) std::cout << fmt::format(" {:<12} {}", (*slurm)[i].job, (*slurm)[i].state);
     std::cout << "\n";
   }
@@ -115,6 +141,11 @@ void register_cohort(CLI::App& app) {
     o.workers = a->workers;
     o.only_cases = split(a->cases);
     o.binary = self_binary();
+    std::vector<std::pair<std::string, std::string>> stage_args;
+    if (!a->until.empty()) stage_args.emplace_back("--until", a->until);
+    if (!a->only.empty()) stage_args.emplace_back("--only", a->only);
+    if (force->count() && !a->force.empty()) stage_args.emplace_back("--force", a->force);
+    check_stage_names(c, o.only_cases, stage_args);
     if (!a->until.empty()) o.run_args.insert(o.run_args.end(), {"--until", a->until});
     if (!a->only.empty()) o.run_args.insert(o.run_args.end(), {"--only", a->only});
     if (force->count()) {
@@ -132,7 +163,10 @@ void register_cohort(CLI::App& app) {
       }
       return rep.exit_code();
     }
-    workflows::write_cohort_summary(c, rep);
+    // The summary keeps one row per case of the cohort, also with --cases.
+    auto whole = rep;
+    workflows::add_unselected_cases(c, whole);
+    workflows::write_cohort_summary(c, whole);
     std::cout << fmt::format("{} cases: {} as expected, {} unexpected failures; summary: {}\n", rep.cases.size(),
                              rep.cases.size() - static_cast<std::size_t>(rep.unexpected()), rep.unexpected(),
                              (c.work_dir / "cohort_summary.csv").string());

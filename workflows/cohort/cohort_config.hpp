@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "workflows/case_config.hpp"
+
 namespace stentsim::workflows {
 
 struct CohortCase {
@@ -16,6 +18,7 @@ struct CohortCase {
   YAML::Node overrides;                    // merged into the template, key by key
   std::optional<std::string> expect_failure;  // stage at which this case is meant to fail
   std::string origin;                      // cases_from: "<key> from <file>" (for messages); empty for `cases`
+  std::vector<std::string> stages;         // the stages of its pipeline plan, in order (set by load_cohort)
 };
 
 /// `backend: slurm` settings (`slurm:` map of the cohort file).
@@ -59,5 +62,11 @@ YAML::Node merged_case(const CohortConfig& c, const CohortCase& k);
 /// Writes each case's merged case file to <work_dir>/<id>/case.yaml (only if
 /// its content changed, so runs stay incremental) and returns their paths.
 std::vector<std::filesystem::path> materialize_cases(const CohortConfig& c);
+
+/// A case's configuration as `stentsim run` in its folder sees it, without
+/// writing anything in the work folder (for `cohort status`): its case.yaml
+/// when that is up to date, else the merged case read from a temporary file
+/// with the same work folder.
+CaseConfig cohort_case_config(const CohortConfig& c, const CohortCase& k);
 
 }  // namespace stentsim::workflows

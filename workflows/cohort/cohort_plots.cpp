@@ -16,10 +16,11 @@ namespace fs = std::filesystem;
 namespace stentsim::workflows {
 namespace {
 
-const std::vector<std::string> kFixedColumns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s"};
+const std::vector<std::string> kFixedColumns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s", "inputs"};
 
+// Fixed and input columns are not QoIs: no plot, no statistics.
 bool is_fixed(const std::string& col) {
-  return std::find(kFixedColumns.begin(), kFixedColumns.end(), col) != kFixedColumns.end();
+  return std::find(kFixedColumns.begin(), kFixedColumns.end(), col) != kFixedColumns.end() || col.rfind("override.", 0) == 0;
 }
 
 std::optional<double> number(const std::string& s) {

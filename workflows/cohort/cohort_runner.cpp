@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -154,6 +155,29 @@ pid_t start_case(const std::string& binary, const fs::path& case_file, const std
 }
 
 const char* const kStartup = "(case start-up)";
+
+/// Case keys that hold a file path (as cohort_config.cpp absolutizes them):
+/// the summary shows their file name.
+bool is_path_key(const std::string& dotted) {
+  const std::string last = dotted.substr(dotted.rfind('.') == std::string::npos ? 0 : dotted.rfind('.') + 1);
+  return last == "file" || last == "lumen" || last == "wall" || last == "path" || last == "image";
+}
+
+/// A YAML node flattened to dotted keys ("mesh.generic.elements_around" ->
+/// "16"); sequences as flow YAML, a null (a removed key) as "null".
+void flatten(const YAML::Node& n, const std::string& prefix, std::vector<std::pair<std::string, std::string>>& out) {
+  if (n.IsMap()) {
+    for (const auto& kv : n) flatten(kv.second, prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar(), out);
+  } else if (n.IsScalar()) {
+    out.emplace_back(prefix, is_path_key(prefix) ? fs::path(n.Scalar()).filename().string() : n.Scalar());
+  } else if (n.IsNull()) {
+    out.emplace_back(prefix, "null");
+  } else {
+    YAML::Emitter e;
+    e << YAML::Flow << n;
+    out.emplace_back(prefix, e.c_str());
+  }
+}
 
 double median_of(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -362,14 +386,28 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
 CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
   // Columns: fixed ones, then "<stage>.<qoi>" for every QoI any case has.
   CohortTable t;
-  std::set<std::string> columns;
+  std::set<std::string> columns, override_columns;
   for (const auto& o : r.cases) {
+    auto k = std::find_if(c.cases.begin(), c.cases.end(), [&](const CohortCase& cc) { return cc.id == o.id; });
     std::map<std::string, std::string> row = {{"case", o.id},
                                               {"status", o.status},
                                               {"exit_code", o.exit_code >= 0 ? std::to_string(o.exit_code) : std::string()},
                                               {"failed_stage", o.failed_stage},
                                               {"message", o.message},
                                               {"wall_time_s", fmt::format("{:.3f}", o.wall_s)}};
+    if (k != c.cases.end()) {
+      // Inputs: the merged case's input section (files by name), then the case's own overrides.
+      std::vector<std::pair<std::string, std::string>> in, ov;
+      flatten(merged_case(c, *k)["input"], "", in);
+      std::string inputs;
+      for (const auto& [key, v] : in) inputs += (inputs.empty() ? "" : "; ") + key + "=" + v;
+      row["inputs"] = inputs;
+      flatten(k->overrides, "", ov);
+      for (const auto& [key, v] : ov) {
+        row["override." + key] = v;
+        override_columns.insert("override." + key);
+      }
+    }
     for (const auto& stage : all_stage_names()) {
       const fs::path f = c.work_dir / o.id / "work" / stage / "summary.yaml";
       if (!fs::exists(f)) continue;
@@ -388,9 +426,81 @@ CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
     }
     t.rows.push_back(std::move(row));
   }
-  t.columns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s"};
+  t.columns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s", "inputs"};
+  t.columns.insert(t.columns.end(), override_columns.begin(), override_columns.end());
   t.columns.insert(t.columns.end(), columns.begin(), columns.end());
   return t;
+}
+
+namespace {
+
+// The cells of one CSV line as write_cohort_summary writes it (every cell quoted, "" for a quote).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char ch = line[i];
+    if (quoted && ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+      cur += '"';
+      ++i;
+    } else if (ch == '"') quoted = !quoted;
+    else if (ch == ',' && !quoted) {
+      out.push_back(cur);
+      cur.clear();
+    } else cur += ch;
+  }
+  out.push_back(cur);
+  return out;
+}
+
+}  // namespace
+
+void add_unselected_cases(const CohortConfig& c, CohortReport& r) {
+  // The previous summary's rows: case id -> column -> cell.
+  std::map<std::string, std::map<std::string, std::string>> previous;
+  const fs::path csv = c.work_dir / "cohort_summary.csv";
+  if (fs::exists(csv)) {
+    std::istringstream in(files::read_text(csv));
+    std::string line;
+    std::getline(in, line);
+    const auto header = csv_fields(line);
+    while (std::getline(in, line)) {
+      const auto cells = csv_fields(line);
+      std::map<std::string, std::string> row;
+      for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
+      if (!row["case"].empty()) previous[row["case"]] = row;
+    }
+  }
+  for (const auto& k : c.cases) {
+    if (std::any_of(r.cases.begin(), r.cases.end(), [&](const CaseOutcome& o) { return o.id == k.id; })) continue;
+    CaseOutcome o;
+    o.id = k.id;
+    if (auto p = previous.find(k.id); p != previous.end() && !p->second["status"].empty()) {
+      auto& row = p->second;
+      o.status = row["status"];
+      o.exit_code = row["exit_code"].empty() ? -1 : std::atoi(row["exit_code"].c_str());
+      o.failed_stage = row["failed_stage"];
+      o.message = row["message"];
+      o.wall_s = std::atof(row["wall_time_s"].c_str());
+    } else {
+      const fs::path manifest = c.work_dir / k.id / "work" / "manifest.yaml";
+      if (!fs::exists(manifest)) {
+        o.status = "not run";
+        o.exit_code = -1;
+      } else {
+        o.failed_stage = failed_stage_of(manifest);
+        if (o.failed_stage.empty()) o.status = "done";
+        else {
+          o.status = k.expect_failure && *k.expect_failure == o.failed_stage ? "failed as expected" : "failed";
+          o.exit_code = -1;  // not known from the manifest
+          o.message = tail_lines(c.work_dir / k.id / "run.log", 3);
+        }
+      }
+    }
+    r.cases.push_back(o);
+  }
+  sort_like_cohort(c, r.cases);
 }
 
 void write_cohort_summary(const CohortConfig& c, const CohortReport& r) {

@@ -96,13 +96,25 @@ std::map<std::string, double> stages_finished_since(const std::filesystem::path&
 CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out);
 
 /// The cohort summary as a table: fixed columns (case, status, exit_code,
-/// failed_stage, message, wall_time_s), then "<stage>.<qoi> [unit]" for every QoI any case's
-/// stage summaries hold, and "<stage>.wall_time_s"; one row per case.
+/// failed_stage, message, wall_time_s, inputs: the merged case's `input`
+/// section as "key=value; ..." with files by name), then "override.<dotted
+/// key>" for every key any case overrides (files by name, a removed key
+/// "null"), then "<stage>.<qoi> [unit]" for every QoI any case's stage
+/// summaries hold, and "<stage>.wall_time_s"; one row per case.
 struct CohortTable {
   std::vector<std::string> columns;
   std::vector<std::map<std::string, std::string>> rows;  // column -> cell
 };
 CohortTable cohort_table(const CohortConfig& c, const CohortReport& r);
+
+/// Adds the cases a run with --cases left out, so that the cohort summary
+/// keeps one row per case of the cohort: each from its row of the previous
+/// cohort_summary.csv when there is one (status, exit code, failed stage,
+/// message, wall time; its QoIs come from its stage summaries as they stand),
+/// else from its manifest ("done", or "failed"/"failed as expected" at its
+/// failed stage), else "not run". Call before write_cohort_summary and after
+/// taking the exit code: these cases were not part of this run.
+void add_unselected_cases(const CohortConfig& c, CohortReport& r);
 
 /// Writes <work_dir>/cohort_summary.csv (the table above), then
 /// cohort_summary.md and one PNG per numeric QoI beside it (cohort_plots.hpp).
