@@ -272,7 +272,11 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
   plgchr(&def_ht, &char_ht);
   plgspa(&px0, &px1, &py0, &py1);
   const double page_w = px1 - px0, page_h = py1 - py0;
-  const double legend_w = (0.6 * 0.8 * static_cast<double>(longest_legend) + 5.0) * char_ht;
+  // The legend's width: text at the legend's 0.8 character scale, glyphs
+  // up to ~0.75 heights wide (digits, "=", capitals in the cairo font; 0.6
+  // clipped "tet10-curved (p = 2.91)" to "...(p = 2.9"), plus the symbol/line
+  // sample, the offsets and the box padding.
+  const double legend_w = (0.75 * 0.8 * static_cast<double>(longest_legend) + 7.0) * char_ht;
   const double right = with_legend ? std::max(0.45, 0.97 - legend_w / page_w - 0.06) : 0.95;
   const double tick_disp = 0.7;  // gap between axis and category names, in character heights
   const double names_ht = 0.62 * static_cast<double>(longest_tick) + tick_disp;
@@ -302,25 +306,8 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
     pllab(plain(axis_title(f.x)).c_str(), plain(axis_title(f.y)).c_str(), plain(f.title).c_str());
   }
 
-  for (std::size_t i = 0; i < f.series.size(); ++i) {
-    const auto& s = f.series[i];
-    const PLINT colour = first_series + static_cast<PLINT>(i % n_series);
-    const std::string symbol = glyph(resolve(s.marker, i));
-    plcol0(colour);
-    if (s.style != Style::markers) {
-      plwidth(2.0);
-      draw_lines(s.x, s.y, f);
-      plwidth(1.0);
-    }
-    if (s.style != Style::lines) draw_markers(s.x, s.y, f, symbol.c_str());
-    if (!s.label.empty()) {
-      PLINT opt = 0;
-      if (s.style != Style::markers) opt |= PL_LEGEND_LINE;
-      if (s.style != Style::lines) opt |= PL_LEGEND_SYMBOL;
-      legend.push_back({s.label, opt, colour, symbol, 1.0});
-    }
-  }
-  for (const auto& h : f.highlights) {
+  std::vector<LegendEntry> highlight_legend;
+  auto draw_highlight = [&](const Highlight& h) {
     const PLINT colour = h.warning_colour ? warning : highlight;
     const std::string symbol = glyph(h.marker == Marker::automatic ? Marker::circle : h.marker);
     if (h.connect) {
@@ -348,9 +335,32 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
     draw_markers(h.x, h.y, f, symbol.c_str());
     plschr(0.0, 1.0);
     if (!h.label.empty())
-      legend.push_back({h.label, PL_LEGEND_SYMBOL | (h.connect ? PL_LEGEND_LINE : 0), colour,
+      highlight_legend.push_back({h.label, PL_LEGEND_SYMBOL | (h.connect ? PL_LEGEND_LINE : 0), colour,
                         symbol, 1.25});
+  };
+  for (const auto& h : f.highlights)
+    if (h.beneath_series) draw_highlight(h);
+  for (std::size_t i = 0; i < f.series.size(); ++i) {
+    const auto& s = f.series[i];
+    const PLINT colour = first_series + static_cast<PLINT>(i % n_series);
+    const std::string symbol = glyph(resolve(s.marker, i));
+    plcol0(colour);
+    if (s.style != Style::markers) {
+      plwidth(2.0);
+      draw_lines(s.x, s.y, f);
+      plwidth(1.0);
+    }
+    if (s.style != Style::lines) draw_markers(s.x, s.y, f, symbol.c_str());
+    if (!s.label.empty()) {
+      PLINT opt = 0;
+      if (s.style != Style::markers) opt |= PL_LEGEND_LINE;
+      if (s.style != Style::lines) opt |= PL_LEGEND_SYMBOL;
+      legend.push_back({s.label, opt, colour, symbol, 1.0});
+    }
   }
+  for (const auto& h : f.highlights)
+    if (!h.beneath_series) draw_highlight(h);
+  legend.insert(legend.end(), highlight_legend.begin(), highlight_legend.end());
   if (with_legend && !legend.empty()) {
     for (auto& e : legend) e.text = plain(e.text);
     draw_legend(legend);

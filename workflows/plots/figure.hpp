@@ -36,6 +36,9 @@ struct Highlight {
   Marker marker = Marker::circle;
   bool connect = false;
   bool warning_colour = false;  ///< red instead of the highlight gold
+  /// Drawn before the series (a marked set, e.g. a Pareto front, that must
+  /// not hide the lines running through it); default: on top.
+  bool beneath_series = false;
 };
 
 struct Axis {

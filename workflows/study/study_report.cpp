@@ -277,7 +277,8 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
       f.series.push_back(std::move(sorted));
       any = true;
     }
-    plots::Highlight front_h{"Pareto front", {}, {}, plots::Marker::diamond, true, false};
+    // Under the lines: a line whose points are all on the front stays visible.
+    plots::Highlight front_h{"Pareto front", {}, {}, plots::Marker::diamond, true, false, true};
     for (auto i : o.pareto)
       if (results[i].wall_s > 0 && o.error[i] > 0) {
         front_h.x.push_back(results[i].wall_s);
