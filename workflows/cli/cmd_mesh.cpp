@@ -24,6 +24,9 @@ void register_mesh(CLI::App& app) {
   c->add_option("--media-ratio", a->o.media_ratio, "Media thickness / local outer diameter (0: no media)");
   c->add_option("--adventitia-ratio", a->o.adventitia_ratio, "Adventitia thickness / local outer diameter (0: none)");
   c->add_option("--min-intima", a->o.min_intima, "Thinnest intima in mm");
+  c->add_option("--min-size-ratio", a->o.min_size_ratio,
+                "Smallest local element size as a fraction of --size (the floor --min-elements-per-layer may not undercut)")
+      ->check(CLI::Range(1e-3, 1.0));
   c->add_flag("!--no-intima", a->o.intima, "Media reaches the lumen (no intima)");
   c->add_option("--station-spacing", a->o.station_spacing, "Distance of the lofted cross-sections in mm");
   c->add_option("--min-scaled-jacobian", a->o.min_scaled_jacobian, "Quality bound");
