@@ -18,7 +18,8 @@ using LayerAngles = std::map<int, double>;
 
 /// The fiber field on the volume cells of `mesh` (faces are skipped): a copy
 /// of the volume mesh with cell arrays Radial, Circumferential, Longitudinal,
-/// Fiber1, Fiber2 (unit vectors) and Layer. Throws InputError for a layer
+/// Fiber1, Fiber2 (unit vectors), Layer and Transmural (cell and point data,
+/// ln(r/r_i)/ln(r_o/r_i), the harmonic transmural coordinate). Throws InputError for a layer
 /// without an angle.
 MeshData tube_fibers(const MeshData& mesh, const LayerAngles& angles);
 

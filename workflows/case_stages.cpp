@@ -47,7 +47,7 @@ Stage patient_mesh_stage(const CaseConfig& c) {
   s.inputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp", "centerline/centerline.vtp"};
   s.outputs = {"mesh/artery.vtu", "mesh/artery.msh"};
   s.config = slice(c, {"mesh"});
-  s.version = "2";  // 2: per-layer sizing, tet10 midside-node Jacobian check
+  s.version = "3";  // 3: gmsh Delaunay (reproducible), symmetric section tangents, pre-loft section checks; 2: per-layer sizing, tet10 midside-node Jacobian check
   const meshing::PatientMeshOptions o = c.mesh;
   s.run = [o](StageContext& ctx) {
     meshing::run_patient_mesh(ctx.input("segmentation/lumen.vtp"), ctx.input("segmentation/wall.vtp"),
@@ -63,7 +63,7 @@ Stage tube_fibers_stage(const CaseConfig& c) {
   s.inputs = {"mesh/artery.vtu"};
   s.outputs = {"fibers/fibers.vtu"};
   s.config = slice(c, {"fibers"});
-  s.version = "1";
+  s.version = "2";  // 2: Transmural cell and point arrays
   const fibers::LayerAngles angles = {{tags::intima, c.fibers.intima_angle},
                                       {tags::media, c.fibers.media_angle},
                                       {tags::adventitia, c.fibers.adventitia_angle}};
