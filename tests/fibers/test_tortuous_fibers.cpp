@@ -25,14 +25,7 @@ using Vec3 = Eigen::Vector3d;
 
 TEST(TortuousFibers, PhantomCenterlineMeshFibersFramesAndAngles) {
   const fs::path dir = fs::temp_directory_path() / "stentsim_test_tortuous_fibers";
-  fs::remove_all(dir);
-  auto r = run_stentsim("phantom --preset tortuous --out " + dir.string());
-  ASSERT_EQ(r.code, 0) << r.out;
-  r = run_stentsim("centerline --lumen " + (dir / "lumen.vtp").string() + " --out " + (dir / "centerline.vtp").string());
-  ASSERT_EQ(r.code, 0) << r.out;
-  r = run_stentsim("mesh --lumen " + (dir / "lumen.vtp").string() + " --wall " + (dir / "wall.vtp").string() +
-                   " --centerline " + (dir / "centerline.vtp").string() + " --out " + (dir / "mesh").string() +
-                   " --element tet10 --size 0.5");
+  const auto r = stentsim::testing::mesh_phantom("tortuous", dir, "--element tet10 --size 0.5");
   ASSERT_EQ(r.code, 0) << r.out;
   const MeshData mesh = read_vtu((dir / "mesh/artery.vtu").string());
   const MeshData cl = read_vtp((dir / "centerline.vtp").string());

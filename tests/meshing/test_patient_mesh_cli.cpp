@@ -16,14 +16,7 @@ using stentsim::testing::run_stentsim;
 
 TEST(PatientMeshCli, TortuousPhantomMeshesAtCoarseSize) {
   const fs::path dir = fs::temp_directory_path() / "stentsim_test_mesh_tortuous";
-  fs::remove_all(dir);
-  auto r = run_stentsim("phantom --preset tortuous --out " + dir.string());
-  ASSERT_EQ(r.code, 0) << r.out;
-  r = run_stentsim("centerline --lumen " + (dir / "lumen.vtp").string() + " --out " + (dir / "centerline.vtp").string());
-  ASSERT_EQ(r.code, 0) << r.out;
-  r = run_stentsim("mesh --lumen " + (dir / "lumen.vtp").string() + " --wall " + (dir / "wall.vtp").string() +
-                   " --centerline " + (dir / "centerline.vtp").string() + " --out " + (dir / "mesh").string() +
-                   " --element tet4 --size 0.6");
+  const auto r = stentsim::testing::mesh_phantom("tortuous", dir, "--element tet4 --size 0.6");
   ASSERT_EQ(r.code, 0) << r.out;
   const YAML::Node s = YAML::LoadFile((dir / "mesh/summary.yaml").string());
   const double gap = s["qoi"]["min_section_gap_ratio"]["value"].as<double>();

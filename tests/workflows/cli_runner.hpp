@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 namespace stentsim::testing {
@@ -21,6 +22,20 @@ inline CliResult run_stentsim(const std::string& args) {
   while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
   const int status = ::pclose(p);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+/// Phantom -> centerline -> wall mesh through the binary, into `dir` (emptied
+/// first): dir/{lumen,wall,centerline}.vtp and dir/mesh/artery.vtu. Returns the
+/// first failing step's result, or the mesh step's.
+inline CliResult mesh_phantom(const std::string& preset, const std::filesystem::path& dir, const std::string& mesh_args) {
+  std::filesystem::remove_all(dir);
+  auto r = run_stentsim("phantom --preset " + preset + " --out " + dir.string());
+  if (r.code != 0) return r;
+  r = run_stentsim("centerline --lumen " + (dir / "lumen.vtp").string() + " --out " + (dir / "centerline.vtp").string());
+  if (r.code != 0) return r;
+  return run_stentsim("mesh --lumen " + (dir / "lumen.vtp").string() + " --wall " + (dir / "wall.vtp").string() +
+                      " --centerline " + (dir / "centerline.vtp").string() + " --out " + (dir / "mesh").string() + " " +
+                      mesh_args);
 }
 
 }  // namespace stentsim::testing
