@@ -1,12 +1,13 @@
 // The 45° bend cantilever (Bathe & Bolourchi 1979; Simo & Vu-Quoc 1986):
 // arc of radius 100 in the x–y plane, clamped at the origin with tangent +y,
 // dead tip load F e_z. Reference: the rod equations solved by shooting
-// (beam_rod_shooting.hpp), converged to far below the tolerances here.
+// (workflows/study/references/rod_shooting.hpp, shared with the error study),
+// converged to far below the tolerances here.
 #include "solver/beams/beam_loads.hpp"
 #include "solver/beams/beam_term.hpp"
-#include "tests/solver/beam_rod_shooting.hpp"
 #include "tests/solver/beam_test_bodies.hpp"
 #include "tests/solver/beam_test_system.hpp"
+#include "workflows/study/references/rod_shooting.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,6 +19,7 @@
 using namespace stentsim::solver;
 using namespace stentsim::solver::beams;
 using namespace stentsim::solver::beams::testing;
+using namespace stentsim::study::reference;
 
 namespace {
 

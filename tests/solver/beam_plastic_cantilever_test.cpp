@@ -9,6 +9,7 @@
 #include "solver/beams/rotation.hpp"
 #include "tests/solver/beam_test_bodies.hpp"
 #include "tests/solver/beam_test_system.hpp"
+#include "workflows/study/references/plastic_moment_curvature.hpp"
 
 #include <gtest/gtest.h>
 
@@ -47,11 +48,10 @@ struct Cantilever {
 };
 
 // Closed-form curvature of the moment path: elastic to M_y0, then slope E_ep·I;
-// unloading with slope EI from the largest (M_max, κ_max).
+// unloading with slope EI from the largest (M_max, κ_max). The formula is the
+// error study's (workflows/study/references/plastic_moment_curvature.hpp).
 double curvature(const PlasticBendingLaw& law, double M, double M_max) {
-  const double EI = law.E * law.inertia(), EepI = law.E_ep * law.inertia();
-  auto loading = [&](double m) { return m <= law.M_y0 ? m / EI : law.M_y0 / EI + (m - law.M_y0) / EepI; };
-  return M_max <= law.M_y0 ? M / EI : loading(M_max) - (M_max - M) / EI;
+  return stentsim::study::reference::PlasticMomentCurvature(law.E, law.E_ep, law.M_y0, law.inertia()).curvature(M, M_max);
 }
 
 }  // namespace

@@ -541,3 +541,109 @@ TEST(StudyConfigFile, ShippedStudiesLoadPlanAndEstimate) {
   for (const auto& f : others) EXPECT_TRUE(bases.count(fs::weakly_canonical(f))) << f << " is neither a study nor a study's base";
   fs::remove_all(out);
 }
+
+TEST(StudyConvergence, RichardsonOfAQoiTendingToZeroGivesOnlyAnAbsoluteGci) {
+  // f = 0.3 h^2 -> 0: Roache's GCI divides by f1 (0.003 against 0.048 at the
+  // coarsest); it is reported undefined and the absolute GCI is given instead.
+  const std::vector<double> h{0.4, 0.2, 0.1};
+  std::vector<double> f;
+  for (double x : h) f.push_back(0.3 * x * x * 1e-2);
+  const Richardson r = richardson(h, f, 2.0);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_TRUE(r.tends_to_zero);
+  EXPECT_NEAR(r.extrapolated, 0.0, 1e-15);
+  EXPECT_TRUE(std::isnan(r.gci_fine));
+  EXPECT_NEAR(r.gci_fine_absolute, 1.25 * std::abs(f[2] - f[1]) / 3.0, 1e-18);
+  EXPECT_NE(r.message.find("tends to 0"), std::string::npos) << r.message;
+  // Away from 0 both are given and the relative one is Roache's.
+  const Richardson away = richardson(h, {2 + f[0], 2 + f[1], 2 + f[2]}, 2.0);
+  EXPECT_FALSE(away.tends_to_zero);
+  EXPECT_NEAR(away.gci_fine, away.gci_fine_absolute / (2 + f[2]), 1e-15);
+}
+
+TEST(StudyReport, RelativeErrorAgainstAVanishingReferenceIsReportedAbsoluteWithANote) {
+  // QoI = h^2 against a reference 0 (and 1e-15, a closed form's round-off):
+  // relative errors would divide by 0 or by round-off. The study reports
+  // absolute errors / error_scale, says so in the outcome, study.md, the CSV
+  // (error_kind) and the log, and the order is still measured.
+  const fs::path d = fresh_dir("vanishing");
+  write(d / "phantom.yaml", "input:\n  phantom: {preset: straight-healthy, circumferential_points: 64}\n");
+  auto study = [&](const std::string& ref) {
+    write(d / "study.yaml", "base: phantom.yaml\nqoi: q\nreference: {type: value, value: " + ref + "}\nerror_scale: 2\n"
+                            "knobs: [{name: n, key: input.phantom.circumferential_points, values: [16, 32, 64], h: [0.4, 0.2, 0.1],"
+                            " theoretical_order: 2}]\n");
+    return load_study(d / "study.yaml");
+  };
+  for (const std::string ref : {"0", "1.0e-15"}) {
+    SCOPED_TRACE(ref);
+    const StudyConfig s = study(ref);
+    const StudyPlan plan = plan_study(s);
+    std::vector<RunResult> results(plan.runs.size());
+    for (std::size_t i = 0; i < plan.runs.size(); ++i) {
+      results[i].status = "ok";
+      results[i].wall_s = 1.0 + static_cast<double>(i);
+      const double h = run_h(s, plan.runs[i], "n").value_or(0.1);
+      results[i].qoi["q"] = {h * h};
+    }
+    StudyOutcome o;
+    ASSERT_NO_THROW(o = evaluate_study(s, plan, results));
+    EXPECT_FALSE(o.relative_error);
+    EXPECT_NE(o.error_note.find("tends to 0"), std::string::npos) << o.error_note;
+    EXPECT_NE(o.error_note.find("ABSOLUTE"), std::string::npos) << o.error_note;
+    for (std::size_t i = 0; i < plan.runs.size(); ++i)
+      EXPECT_NEAR(o.error[i], std::abs(results[i].qoi["q"][0] - std::stod(ref)) / 2, 1e-15);
+    ASSERT_TRUE(o.lines.at(0).fitted_order.has_value());
+    EXPECT_NEAR(*o.lines[0].fitted_order, 2.0, 1e-6);
+    const auto files = write_report(s, plan, results, o, d / "out");
+    const std::string md = read(files.markdown), csv = read(files.csv);
+    EXPECT_NE(md.find("**Note:** relative error refused"), std::string::npos) << md;
+    EXPECT_NE(md.find("error: absolute / 2"), std::string::npos) << md;
+    EXPECT_NE(csv.find(",absolute,"), std::string::npos) << csv;
+    EXPECT_EQ(csv.find(",relative,"), std::string::npos) << csv;
+  }
+  // A reference away from 0 keeps the relative error, without a note.
+  const StudyConfig s = study("0.5");
+  const StudyPlan plan = plan_study(s);
+  std::vector<RunResult> results(plan.runs.size());
+  for (auto& r : results) r.status = "ok", r.wall_s = 1, r.qoi["q"] = {0.5 + 0.01};
+  const StudyOutcome o = evaluate_study(s, plan, results);
+  EXPECT_TRUE(o.relative_error);
+  EXPECT_TRUE(o.error_note.empty());
+  EXPECT_NEAR(o.error[0], 0.02, 1e-12);
+  fs::remove_all(d);
+}
+
+TEST(StudyRunner, RowsFromAnotherHostAreRecomputedUnlessReuseTimings) {
+  // Issue 11: cached rows from another host are recomputed unless
+  // --reuse-timings (the binary-version case is in CachesRunsAndRerunsOnlyNewPoints).
+  const fs::path d = fresh_dir("host");
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out";
+  std::ostringstream log;
+  ErrorStudyResult first;
+  ASSERT_EQ(run_error_study(phantom_study(d, "[16]"), o, log, &first), 0) << log.str();
+  ASSERT_EQ(first.stats.executed, 2);
+  const std::string here = first.results[1].host;
+  const fs::path result = run_dir(o.out_dir, first.plan.runs[1]) / "result.yaml";
+  std::string text = read(result);
+  const auto pos = text.find("host: ");
+  ASSERT_NE(pos, std::string::npos);
+  text.insert(pos + 6, "another-machine-");
+  write(result, text);
+  o.reuse_timings = true;
+  ErrorStudyResult reused;
+  ASSERT_EQ(run_error_study(d / "study.yaml", o, log, &reused), 0) << log.str();
+  EXPECT_EQ(reused.stats.executed, 0);
+  EXPECT_EQ(reused.results[1].host, "another-machine-" + here);  // the row keeps its own host
+  EXPECT_NE(read(o.out_dir / "study.csv").find("another-machine-"), std::string::npos);
+  o.reuse_timings = false;
+  ErrorStudyResult redone;
+  ASSERT_EQ(run_error_study(d / "study.yaml", o, log, &redone), 0) << log.str();
+  EXPECT_EQ(redone.stats.executed, 1);
+  EXPECT_EQ(redone.stats.cached, 1);
+  EXPECT_EQ(redone.results[1].host, here);
+  EXPECT_FALSE(redone.results[1].cached);
+  EXPECT_EQ(read(result).find("another-machine-"), std::string::npos);
+  fs::remove_all(d);
+}

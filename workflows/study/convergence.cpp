@@ -83,9 +83,16 @@ Richardson richardson(std::vector<double> h, std::vector<double> f, std::optiona
   }
   const double rp = std::pow(r21, r.observed_order);
   r.extrapolated = f1 + (f1 - f2) / (rp - 1);
-  r.gci_fine = f1 != 0 ? 1.25 * std::abs((f1 - f2) / f1) / (rp - 1) : std::nan("");
+  r.gci_fine_absolute = 1.25 * std::abs(f1 - f2) / (rp - 1);
+  // Roache's GCI is relative to f1: meaningless when the QoI tends to 0 (the
+  // extrapolated limit vanishes against the solutions; f1 itself is then
+  // mostly discretisation error).
+  r.tends_to_zero = std::abs(r.extrapolated) <= kVanishingQoi * std::max({std::abs(f1), std::abs(f2), std::abs(f3)});
+  r.gci_fine = r.tends_to_zero ? std::nan("") : 1.25 * std::abs((f1 - f2) / f1) / (rp - 1);
   r.ok = true;
-  r.message = "asymptotic";
+  r.message = r.tends_to_zero ? fmt::format("asymptotic; the QoI tends to 0 (finest {:.3g}, coarsest {:.3g}): relative GCI undefined, "
+                                            "absolute GCI {:.3g}", f1, f3, r.gci_fine_absolute)
+                              : "asymptotic";
   return r;
 }
 

@@ -24,9 +24,20 @@ struct Richardson {
   double ratio = 0;            ///< h_medium / h_fine
   double observed_order = 0;   ///< p = ln((f3 - f2) / (f2 - f1)) / ln r
   double extrapolated = 0;     ///< f1 + (f1 - f2) / (r^p - 1)
-  double gci_fine = 0;         ///< 1.25 |(f1 - f2) / f1| / (r^p - 1)
+  double gci_fine = 0;         ///< 1.25 |(f1 - f2) / f1| / (r^p - 1); NaN when the QoI tends to 0
+  double gci_fine_absolute = 0;  ///< 1.25 |f1 - f2| / (r^p - 1), in the QoI's unit
+  /// The extrapolated limit is at most kVanishingQoi of the largest of the
+  /// three solutions: the QoI tends to 0 and a relative GCI (and relative
+  /// errors) would divide by the discretisation error or round-off; only the
+  /// absolute GCI is reported.
+  bool tends_to_zero = false;
   bool asymptotic = false;     ///< p within 0.5..1.5 x the theoretical order
 };
+
+/// A value whose magnitude is at most this fraction of the largest magnitude
+/// in its series counts as zero for relative measures (relative error, GCI):
+/// dividing by it would report round-off or the approach to 0, not accuracy.
+inline constexpr double kVanishingQoi = 1e-3;
 
 /// From three solutions f at sizes h (any order; the three finest are used).
 /// Requires a constant ratio >= 1.5 (within 1 %) and monotone convergence;

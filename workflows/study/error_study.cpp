@@ -8,6 +8,7 @@
 #include <ostream>
 
 #include "common/error.hpp"
+#include "workflows/study/analytic_references.hpp"
 #include "workflows/study/study_config.hpp"
 
 namespace fs = std::filesystem;
@@ -48,6 +49,10 @@ int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostre
   r.out_dir = o.out_dir.empty() ? file.parent_path() / (study.name + ".study") : o.out_dir;
   r.plan = plan_study(study);
   const std::size_t n = r.plan.runs.size();
+  // A reference the runs' inputs cannot give (a key missing for the
+  // reference, a load case it does not cover) is an InputError before
+  // anything runs, dry run included; the shooting reference caches its solve.
+  for (const auto& run : r.plan.runs) analytic_reference(study, run.input);
   const HostInfo host = this_host(o.binary);
 
   std::vector<std::optional<double>> measured(n);
@@ -111,6 +116,7 @@ int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostre
   r.files = write_report(study, r.plan, r.results, r.outcome, r.out_dir);
   out << fmt::format("{} runs executed, {} cached, {} failed; reference: {}\n", r.stats.executed, r.stats.cached, r.stats.failed,
                      r.outcome.reference_note);
+  if (!r.outcome.error_note.empty()) out << "note: " << r.outcome.error_note << "\n";
   for (const auto& l : r.outcome.lines)
     if (l.fitted_order) out << fmt::format("  order along {}: fitted {:.3f}\n", l.label, *l.fitted_order);
   if (r.outcome.cheapest)

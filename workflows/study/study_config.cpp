@@ -264,10 +264,13 @@ StudyConfig load_study(const fs::path& file) {
     ConfigMap ref = root.map("reference");
     only_keys(ref, {"type", "value", "knob"});
     const std::string type =
-        ref.choice("type", {"tube_plane_strain", "beam_rollup", "value", "qoi_is_error", "richardson"});
+        ref.choice("type", {"tube_plane_strain", "beam_rollup", "beam_plastic_rollup", "beam_shooting", "value", "qoi_is_error",
+                            "richardson"});
     using T = Reference::Type;
-    c.reference.type = type == "tube_plane_strain" ? T::tube_plane_strain
-                       : type == "beam_rollup"     ? T::beam_rollup
+    c.reference.type = type == "tube_plane_strain"     ? T::tube_plane_strain
+                       : type == "beam_rollup"         ? T::beam_rollup
+                       : type == "beam_plastic_rollup" ? T::beam_plastic_rollup
+                       : type == "beam_shooting"       ? T::beam_shooting
                        : type == "value"           ? T::value
                        : type == "qoi_is_error"    ? T::qoi_is_error
                                                    : T::richardson;

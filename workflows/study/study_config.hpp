@@ -36,6 +36,8 @@ struct Reference {
   enum class Type {
     tube_plane_strain,  ///< PlaneStrainTube shooting solution from each run's own scene
     beam_rollup,        ///< closed-form end-moment roll-up of a straight cantilever
+    beam_plastic_rollup,///< the same with the App. C elasto-plastic moment-curvature closed form
+    beam_shooting,      ///< rod equations under a dead tip force by shooting (the 45 deg bend)
     value,              ///< a given value (scalar or vector)
     qoi_is_error,       ///< the QoI is itself an error against a known truth (phantoms)
     richardson,         ///< extrapolated from the three finest settings of a knob

@@ -104,33 +104,55 @@ StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const s
     q[i] = it->second;
     o.value[i] = q[i].size() == 1 ? q[i][0] : norm(q[i]);
   }
+  o.relative_error = s.relative_error;
   auto error_of = [&](const std::vector<double>& v, const std::vector<double>& ref) {
     if (v.size() != ref.size())
       throw InputError(fmt::format("{}: qoi '{}' has {} components but the reference has {}", s.file.string(), s.qoi, v.size(), ref.size()));
     std::vector<double> d(v.size());
     for (std::size_t k = 0; k < v.size(); ++k) d[k] = v[k] - ref[k];
-    if (s.relative_error) {
-      const double r = norm(ref);
-      if (r == 0)
-        throw InputError(fmt::format("{}: error: relative error against a zero reference; use 'error: absolute' (with "
-                                     "error_scale to normalise)", s.file.string()));
-      return norm(d) / r;
+    return o.relative_error ? norm(d) / norm(ref) : norm(d) / s.error_scale;
+  };
+  // Relative errors divide by the reference: when the QoI tends to 0 (a
+  // reference at or below kVanishingQoi of the largest QoI value of the
+  // study, e.g. the roll-up tip back at the root, where the closed form is 0
+  // up to round-off) they would measure that round-off. The study then
+  // reports absolute errors (/ error_scale) and says so everywhere.
+  auto check_relative = [&] {
+    if (!o.relative_error) return;
+    double largest = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!q[i].empty()) largest = std::max(largest, norm(q[i]));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (o.reference[i].empty() || q[i].empty()) continue;
+      const double r = norm(o.reference[i]);
+      if (r > kVanishingQoi * largest && r > 0) continue;
+      o.relative_error = false;
+      o.error_note = fmt::format(
+          "relative error refused: the QoI tends to 0 (reference |{}| = {:.3g} for run {} ({}) is at most {:g} of the largest "
+          "value {:.3g}); errors are ABSOLUTE, |value - reference| / error_scale ({:g}). Write 'error: absolute' in {} to "
+          "make this explicit",
+          s.qoi, r, plan.runs[i].key.substr(0, 8), plan.runs[i].label, kVanishingQoi, largest, s.error_scale, s.file.filename().string());
+      return;
     }
-    return norm(d) / s.error_scale;
   };
 
   using T = Reference::Type;
   switch (s.reference.type) {
     case T::tube_plane_strain:
     case T::beam_rollup:
+    case T::beam_plastic_rollup:
+    case T::beam_shooting:
     case T::value:
-      o.reference_note = s.reference.type == T::tube_plane_strain ? "plane-strain neo-Hooke tube, shooting solution (Odeint) per run"
-                         : s.reference.type == T::beam_rollup   ? "closed-form end-moment roll-up per run"
+      o.reference_note = s.reference.type == T::tube_plane_strain     ? "plane-strain neo-Hooke tube, shooting solution (Odeint) per run"
+                         : s.reference.type == T::beam_rollup         ? "closed-form end-moment roll-up per run"
+                         : s.reference.type == T::beam_plastic_rollup ? "closed-form elasto-plastic moment-curvature (App. C) end-moment "
+                                                                        "cantilever per run"
+                         : s.reference.type == T::beam_shooting ? "Simo-Reissner rod under the dead tip force, RK4 shooting per run"
                                                                 : "given value";
-      for (std::size_t i = 0; i < n; ++i) {
-        o.reference[i] = analytic_reference(s, plan.runs[i].input);
+      for (std::size_t i = 0; i < n; ++i) o.reference[i] = analytic_reference(s, plan.runs[i].input);
+      check_relative();
+      for (std::size_t i = 0; i < n; ++i)
         if (!q[i].empty()) o.error[i] = error_of(q[i], o.reference[i]);
-      }
       break;
     case T::qoi_is_error:
       o.reference_note = fmt::format("the QoI '{}' is itself the error against the known truth", s.qoi);
@@ -157,8 +179,11 @@ StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const s
       const Richardson r = richardson(h, f, theoretical_order_for(s, k, {}));
       double ref = r.extrapolated;
       if (r.ok) {
-        o.reference_note = fmt::format("Richardson extrapolation along '{}' (ratio {:.3g}, observed order {:.3g}, GCI fine {:.3g})",
-                                       k.name, r.ratio, r.observed_order, r.gci_fine);
+        o.reference_note = fmt::format("Richardson extrapolation along '{}' (ratio {:.3g}, observed order {:.3g}, {})", k.name, r.ratio,
+                                       r.observed_order,
+                                       r.tends_to_zero ? fmt::format("QoI tends to 0: relative GCI undefined, absolute GCI fine {:.3g}",
+                                                                     r.gci_fine_absolute)
+                                                       : fmt::format("GCI fine {:.3g}", r.gci_fine));
       } else {
         // Not extrapolated: errors are differences to the finest run, and say so.
         const auto finest = std::min_element(h.begin(), h.end()) - h.begin();
@@ -166,10 +191,11 @@ StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const s
         o.reference_note = fmt::format("Richardson along '{}' NOT done ({}); errors below are differences to the finest run", k.name,
                                        r.message);
       }
-      for (std::size_t i = 0; i < n; ++i) {
-        o.reference[i] = {ref};
+      for (std::size_t i = 0; i < n; ++i)
+        if (q[i].size() == 1) o.reference[i] = {ref};
+      check_relative();
+      for (std::size_t i = 0; i < n; ++i)
         if (q[i].size() == 1) o.error[i] = error_of(q[i], o.reference[i]);
-      }
       break;
     }
   }
@@ -225,7 +251,7 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
     std::ostringstream csv;
     csv << "run,label,status,cached";
     for (const auto& k : s.knobs) csv << "," << csv_field(k.name);
-    csv << ",qoi,value,reference,error,wall_time_s,cpu_time_s,peak_memory_mb,peak_memory_rule,ranks,host,nproc,load_average,binary_version,pareto,message";
+    csv << ",qoi,value,reference,error,error_kind,wall_time_s,cpu_time_s,peak_memory_mb,peak_memory_rule,ranks,host,nproc,load_average,binary_version,pareto,message";
     for (const auto& name : qoi_names) csv << "," << csv_field("qoi." + name);
     csv << "\n";
     for (std::size_t i = 0; i < plan.runs.size(); ++i) {
@@ -233,7 +259,7 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
       const auto& run = plan.runs[i];
       csv << run.key << "," << csv_field(run.label) << "," << r.status << "," << (r.cached ? "yes" : "no");
       for (const auto& k : s.knobs) csv << "," << csv_field(setting_label(s, run, k.name));
-      csv << "," << s.qoi << "," << num(o.value[i]) << "," << join(o.reference[i]) << "," << num(o.error[i]) << "," << num(r.wall_s)
+      csv << "," << s.qoi << "," << num(o.value[i]) << "," << join(o.reference[i]) << "," << num(o.error[i]) << "," << (o.relative_error ? "relative" : "absolute") << "," << num(r.wall_s)
           << "," << num(r.cpu_s) << "," << num(r.peak_memory_mb) << "," << csv_field(r.peak_memory_rule) << "," << run.ranks << "," << csv_field(r.host) << "," << r.nproc << ","
           << num(r.load_average) << "," << r.version << "," << (front.count(i) ? "yes" : "no") << "," << csv_field(r.message);
       for (const auto& name : qoi_names) {
@@ -254,7 +280,7 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
     plots::Figure f;
     f.title = fmt::format("{}: error of {} against wall time", s.name, s.qoi);
     f.x = {"wall time", "s", true, std::nullopt, std::nullopt, {}};
-    f.y = {s.relative_error ? "relative error" : "error", "", true, std::nullopt, std::nullopt, {}};
+    f.y = {o.relative_error ? "relative error" : "error", "", true, std::nullopt, std::nullopt, {}};
     bool any = false;
     for (const auto& line : o.lines) {
       plots::Series ser{line.label, {}, {}, plots::Style::lines_and_markers, plots::Marker::automatic};
@@ -299,7 +325,7 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
     plots::Figure f;
     f.title = fmt::format("{}: error of {} against mesh size", s.name, s.qoi);
     f.x = {"h", "mm", true, std::nullopt, std::nullopt, {}};
-    f.y = {s.relative_error ? "relative error" : "error", "", true, std::nullopt, std::nullopt, {}};
+    f.y = {o.relative_error ? "relative error" : "error", "", true, std::nullopt, std::nullopt, {}};
     bool any = false;
     for (const auto& line : o.lines) {
       if (line.h.empty() || !std::isfinite(line.h.front())) continue;
@@ -347,7 +373,8 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
     std::ostringstream m;
     m << "# Error study: " << md(s.name) << "\n\n";
     m << "Study file: `" << s.file.string() << "`; base: `" << s.base_file.string() << "`; QoI: `" << s.qoi << "`; error: "
-      << (s.relative_error ? "relative" : fmt::format("absolute / {}", s.error_scale)) << ".\n\n";
+      << (o.relative_error ? "relative" : fmt::format("absolute / {}", s.error_scale)) << ".\n\n";
+    if (!o.error_note.empty()) m << "**Note:** " << md(o.error_note) << ".\n\n";
     m << "Reference: " << md(o.reference_note) << ".\n\n";
     std::set<std::string> hosts;
     for (const auto& r : results)
@@ -377,15 +404,19 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
         if (l.pairwise_orders.empty()) continue;
         std::string rich = "-";
         if (l.richardson)
-          rich = l.richardson->ok ? fmt::format("p = {:.3g}, extrapolated {:.8g}, GCI {:.3g}", l.richardson->observed_order,
-                                                l.richardson->extrapolated, l.richardson->gci_fine)
-                                  : l.richardson->message;
+          rich = !l.richardson->ok ? l.richardson->message
+                 : l.richardson->tends_to_zero
+                     ? fmt::format("p = {:.3g}, extrapolated {:.8g}, QoI tends to 0: absolute GCI {:.3g} (relative undefined)",
+                                   l.richardson->observed_order, l.richardson->extrapolated, l.richardson->gci_fine_absolute)
+                     : fmt::format("p = {:.3g}, extrapolated {:.8g}, GCI {:.3g}", l.richardson->observed_order,
+                                   l.richardson->extrapolated, l.richardson->gci_fine);
         m << fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", md(l.label), join(l.h), join(l.error), join(l.pairwise_orders),
                          l.fitted_order ? fmt::format("{:.3f}", *l.fitted_order) : "-",
                          l.theoretical_order ? fmt::format("{:.3g}", *l.theoretical_order) : "-", md(rich));
       }
     }
     m << "\n## Cheapest within tolerance\n\n";
+    if (s.tolerance && !o.error_note.empty()) m << "The tolerance is compared with the absolute errors (see the note above).\n\n";
     if (!s.tolerance) m << "No `tolerance` in the study file.\n";
     else if (o.cheapest)
       m << fmt::format("Tolerance {:.3g}: **{}** (error {:.3g}, {:.3g} s wall).\n", *s.tolerance, md(plan.runs[*o.cheapest].label),

@@ -33,6 +33,10 @@ struct StudyOutcome {
   std::vector<std::size_t> pareto; ///< runs on the front, by increasing wall time
   std::optional<std::size_t> cheapest;  ///< cheapest run with error <= tolerance
   std::string reference_note;      ///< how the reference was obtained
+  /// The error kind used: the study's, except that a relative error becomes
+  /// absolute (/ error_scale) when the QoI tends to 0 (error_note says why).
+  bool relative_error = true;
+  std::string error_note;          ///< non-empty when the error kind was changed
 };
 
 /// A run that succeeded but whose summary.yaml does not hold the study's QoI
@@ -47,7 +51,8 @@ int fail_runs_missing_qoi(const StudyConfig& study, const StudyPlan& plan, std::
 std::size_t edit_distance(const std::string& a, const std::string& b);
 
 /// Errors, orders, front. Throws InputError for a study whose reference does
-/// not fit its QoI (e.g. a relative error against a zero reference).
+/// not fit its QoI (component count). A relative error against a reference
+/// that vanishes (kVanishingQoi) is reported as absolute, with error_note.
 StudyOutcome evaluate_study(const StudyConfig& study, const StudyPlan& plan, const std::vector<RunResult>& results);
 
 /// Files written into `out_dir`.
