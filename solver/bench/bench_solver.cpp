@@ -17,6 +17,7 @@
 // stall (2000 iterations, 1e-4..1e-6) once the fibers are stretched.
 // --coarse / --mesh print the state after every step. Run under mpirun -np 2 for two ranks.
 #include <mpi.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -45,6 +46,12 @@ std::array<Vec3, 3> cylindrical_frame(const MeshData& m, std::size_t c) {
   for (auto n : conn) x += m.points[static_cast<std::size_t>(n)];
   const Vec3 er = Vec3(x.x(), x.y(), 0).normalized();
   return {er, Vec3::UnitZ().cross(er), Vec3::UnitZ()};
+}
+
+double cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
 // Discards contributions (measures element evaluation alone).
@@ -151,8 +158,9 @@ int main(int argc, char** argv) {
     st.dt_initial = prestress_only ? 1.0 : 0.5;
     st.dt_max = st.dt_initial;
     st.stops = {1.0};
-    double assembly = 0, solve = 0;
+    double assembly = 0, solve = 0, setup = 0;
     int iterations = 0, linear_its = 0;
+    const double cpu0 = cpu_seconds();
     const auto t0 = Clock::now();
     // Mid-length inner radius, and the largest fiber stretch sqrt(I4) per layer
     // (I4 = 1 + 2 a.E.a with the cell-mean Green-Lagrange strain).
@@ -186,6 +194,7 @@ int main(int argc, char** argv) {
       run_load_steps(model, sys, *linear, u, st, {}, [&](const StepRecord& r) {
         assembly += r.assembly_seconds;
         solve += r.linear_seconds;
+        setup += r.linear_setup_seconds;
         iterations += r.newton_iterations;
         linear_its += r.linear_iterations;
         if (coarse) report_state(r.time);
@@ -198,9 +207,11 @@ int main(int argc, char** argv) {
     const double r_in_mid = mid_inner_radius();
     if (model.rank == 0)
       std::printf("case1 artery: %lld DOFs, %d rank(s), %s: %d Newton its, %d linear its; per Newton iteration: "
-                  "assembly %.3f s, linear solve %.3f s; total %.1f s; mid inner radius at the end %.4f mm\n",
+                  "assembly %.3f s, linear solve %.3f s (set-up %.3f s, Krylov/solve %.3f s); total %.1f s wall, %.1f s CPU "
+                  "(rank 0); mid inner radius at the end %.4f mm\n",
                   static_cast<long long>(model.dofs.size()), model.ranks, linear->describe().c_str(), iterations, linear_its,
-                  assembly / iterations, solve / iterations, total, r_in_mid);
+                  assembly / iterations, solve / iterations, setup / iterations, (solve - setup) / iterations, total,
+                  cpu_seconds() - cpu0, r_in_mid);
   }
   MPI_Finalize();
   return 0;

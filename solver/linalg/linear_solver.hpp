@@ -1,7 +1,8 @@
 #pragma once
 // The linear-solver interface the nonlinear solver sees. Implementations:
-// Trilinos (Amesos2 KLU2 direct; Belos GMRES with Ifpack2 ILU(k) or MueLu AMG;
-// trilinos_solvers.cpp, the only C++17 file) and Eigen's SparseLU as a
+// UMFPACK sparse LU ("direct", umfpack_solver.cpp; gathered on rank 0 on
+// several ranks), Trilinos Belos GMRES with Ifpack2 ILU(k) or MueLu AMG
+// (trilinos_solvers.cpp, the only C++17 file) and Eigen's SparseLU as a
 // dependency-light reference.
 #include <Eigen/Core>
 
@@ -13,7 +14,7 @@
 namespace stentsim::solver {
 
 struct LinearSolverSettings {
-  /// "direct" (Amesos2 KLU2), "gmres_ilu" (Belos GMRES + Ifpack2 RILUK),
+  /// "direct" (UMFPACK sparse LU), "gmres_ilu" (Belos GMRES + Ifpack2 RILUK),
   /// "gmres_amg" (Belos GMRES + MueLu SA-AMG, rigid-body near-null space), "eigen_lu".
   std::string type = "direct";
   double tolerance = 1e-10;   // relative residual of the Krylov solver
@@ -58,7 +59,11 @@ std::unique_ptr<LinearSolver> make_linear_solver(const LinearSolverSettings& set
 
 /// The Eigen SparseLU reference solver (single rank).
 std::unique_ptr<LinearSolver> make_eigen_lu_solver();
-/// Trilinos solvers ("direct", "gmres_ilu", "gmres_amg").
+/// SuiteSparse UMFPACK sparse LU (single rank; keeps the symbolic analysis
+/// while the pattern stays the same).
+std::unique_ptr<LinearSolver> make_umfpack_solver();
+/// "direct" (UMFPACK; on several ranks the matrix is gathered on rank 0),
+/// "gmres_ilu", "gmres_amg".
 std::unique_ptr<LinearSolver> make_trilinos_solver(const LinearSolverSettings& settings);
 
 }  // namespace stentsim::solver

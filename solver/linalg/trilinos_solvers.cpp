@@ -1,10 +1,10 @@
 // Trilinos adapter (compiled as C++17: Teuchos 13.2 does not build as C++20).
 // Tpetra CrsMatrix from the assembled CSR (rows summed over ranks by
-// fillComplete), then Amesos2 KLU2, or Belos block GMRES preconditioned by
+// fillComplete), then ("direct" on several ranks) gathered on rank 0 for
+// UMFPACK, or Belos block GMRES preconditioned by
 // Ifpack2 RILUK (ILU(k); additive Schwarz over ranks) or MueLu smoothed
 // aggregation with the rigid-body near-null space (paper Section 4.2.1:
 // GMRES, ILU(4), Krylov space 200).
-#include <Amesos2.hpp>
 #include <BelosBlockGmresSolMgr.hpp>
 #include <BelosLinearProblem.hpp>
 #include <BelosTpetraAdapter.hpp>
@@ -21,7 +21,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -67,16 +66,18 @@ class TrilinosSolver : public LinearSolver {
 
   std::string describe() const override {
     if (settings_.type == "direct")
-      return comm_->getSize() > 1 ? "direct: matrix gathered on rank 0, Eigen SparseLU there (serial)" : "Amesos2 KLU2 (direct)";
+      return comm_->getSize() > 1 ? "direct: matrix gathered on rank 0, UMFPACK sparse LU there (serial)" : "UMFPACK sparse LU (direct)";
     std::ostringstream o;
     o << "Belos block GMRES (Krylov space " << settings_.krylov_size << ", tol " << settings_.tolerance << ") + ";
     if (settings_.type == "gmres_ilu") o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
     else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space, symmetric Gauss-Seidel)";
-    else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node)";
+    else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node, symmetric Gauss-Seidel)";
     return o.str();
   }
 
   LinearSolveStats solve(const CsrMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x) override {
+    // One rank: its contributions are the whole matrix, no Tpetra copy needed.
+    if (settings_.type == "direct" && comm_->getSize() == 1) return direct_->solve(a, b, x);
     LinearSolveStats stats;
     const auto t0 = Clock::now();
     const GO n = static_cast<GO>(a.rows);
@@ -87,23 +88,15 @@ class TrilinosSolver : public LinearSolver {
     xv->putScalar(0.0);
 
     if (settings_.type == "direct" && comm_->getSize() > 1) {
-      // Amesos2 KLU2 on a distributed matrix returned wrong solutions with
-      // Debian's Trilinos 13.2 (caught by test_solver_mpi_two_ranks); gather
-      // the assembled matrix on rank 0 instead, factor it there and broadcast.
+      // Amesos2 has only KLU2 and Tacho here, and KLU2 on a distributed matrix
+      // returned wrong solutions with Debian's Trilinos 13.2 (caught by
+      // test_solver_mpi_two_ranks): gather the assembled matrix on rank 0,
+      // factor it there with UMFPACK and broadcast.
       stats = gathered_direct_solve(mat, map, b, x);
       stats.setup_seconds += seconds(t0, Clock::now()) - stats.solve_seconds;
       return stats;
     }
-    if (settings_.type == "direct") {
-      auto direct = Amesos2::create<Matrix, MV>("KLU2", mat, xv, bv);
-      direct->symbolicFactorization().numericFactorization();
-      const auto t1 = Clock::now();
-      direct->solve();
-      stats.setup_seconds = seconds(t0, t1);
-      stats.solve_seconds = seconds(t1, Clock::now());
-      stats.iterations = 1;
-      stats.converged = true;
-    } else {
+    {
       RCP<OP> prec = make_preconditioner(mat, map, stats);
       const auto t1 = Clock::now();
       auto problem = rcp(new Belos::LinearProblem<SC, MV, OP>(mat, xv, bv));
@@ -177,6 +170,7 @@ class TrilinosSolver : public LinearSolver {
     gathered->doExport(*mat, exporter, Tpetra::INSERT);
     gathered->fillComplete(gmap, gmap);
     LinearSolveStats stats;
+    std::string failure;
     x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
     if (root) {
       CsrMatrix a;
@@ -193,8 +187,15 @@ class TrilinosSolver : public LinearSolver {
         for (const auto& [c, v] : row) a.cols.push_back(c), a.values.push_back(v);
         a.row_ptr[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(a.cols.size());
       }
-      stats = make_eigen_lu_solver()->solve(a, b, x);
+      try {
+        stats = direct_->solve(a, b, x);
+      } catch (const std::exception& e) {
+        failure = e.what();  // thrown on every rank below: the others would wait in the broadcast
+      }
     }
+    int failed = failure.empty() ? 0 : 1;
+    Teuchos::broadcast<int, int>(*comm_, 0, 1, &failed);
+    if (failed) throw std::runtime_error(root ? failure : "the direct solve on rank 0 failed");
     Teuchos::broadcast<int, double>(*comm_, 0, static_cast<int>(n), x.data());
     int ok = stats.converged ? 1 : 0;
     Teuchos::broadcast<int, int>(*comm_, 0, 1, &ok);
@@ -248,23 +249,23 @@ class TrilinosSolver : public LinearSolver {
       p.set("multigrid algorithm", std::string("sa"));
       p.set("number of equations", settings_.amg_equations_per_node);
       p.set("coarse: max size", 1000);
-      if (settings_.amg_equations_per_node == 1) {
-        // Scalar problems (the fibers' Laplace solves): symmetric Gauss-Seidel.
-        // Chebyshev smoothing relies on a power-iteration estimate of the
-        // largest eigenvalue of D^-1 A (10 iterations by default); on
-        // quadratic tets from gmsh's Delaunay mesher (aspect ratio up to ~12)
-        // the few large, element-local eigenvalues are missed, the smoother
-        // amplifies those modes and GMRES stagnated (straight-healthy tet10
-        // 0.25 mm: 3e-6 after 5000 iterations, issue 5). Gauss-Seidel needs
-        // no spectral estimate and is convergent for any SPD matrix; one
-        // forward and one backward sweep keep the V-cycle symmetric.
-        p.set("smoother: type", std::string("RELAXATION"));
-        Teuchos::ParameterList& sp = p.sublist("smoother: params");
-        sp.set("relaxation: type", std::string("Symmetric Gauss-Seidel"));
-        sp.set("relaxation: sweeps", 1);
-      } else {
-        p.set("smoother: type", std::string("CHEBYSHEV"));
-      }
+      // Symmetric Gauss-Seidel smoothing, for the scalar Laplace problems of the
+      // fibers and for elasticity alike. MueLu's default Chebyshev smoother
+      // relies on a power-iteration estimate of the largest eigenvalue of
+      // D^-1 A (10 iterations); where that misses the few large, element-local
+      // eigenvalues (quadratic tets from gmsh's Delaunay mesher with aspect
+      // ratio up to ~12; the stretched anisotropic HGO wall) the smoother
+      // amplifies those modes and GMRES stagnates (straight-healthy tet10
+      // fibers: 3e-6 after 5000 iterations, issue 5; Case 1 artery at 85 mmHg:
+      // 714 GMRES iterations over 6 Newton iterations with Chebyshev, 422 with
+      // Gauss-Seidel, bench_solver). Gauss-Seidel needs no spectral estimate and
+      // converges for any SPD matrix; a forward and a backward sweep keep the
+      // V-cycle symmetric. (In parallel, Ifpack2 applies it per rank: hybrid
+      // Gauss-Seidel/Jacobi.)
+      p.set("smoother: type", std::string("RELAXATION"));
+      Teuchos::ParameterList& sp = p.sublist("smoother: params");
+      sp.set("relaxation: type", std::string("Symmetric Gauss-Seidel"));
+      sp.set("relaxation: sweeps", 1);
       check_near_null_space(static_cast<GO>(map->getGlobalNumElements()));
       if (modes_.size() > 0) {
         RCP<MV> ns = rcp(new MV(map, static_cast<std::size_t>(modes_.cols())));
@@ -283,6 +284,8 @@ class TrilinosSolver : public LinearSolver {
 
   LinearSolverSettings settings_;
   RCP<const Teuchos::Comm<int>> comm_;
+  // "direct": UMFPACK on rank 0 (keeps its symbolic analysis while the pattern stays).
+  std::unique_ptr<LinearSolver> direct_ = make_umfpack_solver();
   Eigen::MatrixXd modes_;
 };
 

@@ -34,6 +34,7 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
       rec.linear_iterations += nr.linear_iterations;
       rec.assembly_seconds += nr.assembly_seconds;
       rec.linear_seconds += nr.linear_seconds;
+      rec.linear_setup_seconds += nr.linear_setup_seconds;
       if (nr.converged) {
         model.commit();
         t += h;

@@ -55,6 +55,7 @@ struct StepRecord {
   double time = 0.0, dt = 0.0;
   int newton_iterations = 0, linear_iterations = 0, cuts = 0;  // every attempt of the step, the cut ones included
   double wall_seconds = 0.0, assembly_seconds = 0.0, linear_seconds = 0.0;
+  double linear_setup_seconds = 0.0;  // part of linear_seconds: matrix build, factorization / preconditioner
   double next_dt = 0.0;        // the step size the stepper tries next (restart resumes with it)
   std::vector<double> residual_norms;
 };

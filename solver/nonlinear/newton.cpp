@@ -58,6 +58,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
       return fail(fmt::format("linear solver failed: {}", e.what()));
     }
     res.linear_seconds += since(t0);
+    res.linear_setup_seconds += ls.setup_seconds;
     res.linear_iterations += ls.iterations;
     if (!du.allFinite()) return fail("linear solver returned a non-finite increment");
     if (!ls.converged) log::warn("linear solver did not converge: relative residual {:.2e} after {} iterations",

@@ -29,6 +29,7 @@ struct NewtonResult {
   std::vector<double> residual_norms;  // free-DOF residual, per iteration (index 0 = before the first solve)
   std::string failure;                 // why it failed (last element failure or divergence)
   double assembly_seconds = 0.0, linear_seconds = 0.0;
+  double linear_setup_seconds = 0.0;  // part of linear_seconds: matrix build, factorization / preconditioner
 };
 
 /// Solves the step ending at `time` (size dt) starting from u (updated in
