@@ -3,7 +3,7 @@
 // equilibrium (solver/beams/beam_resultants.hpp), against exact references.
 // - 45° bend (Bathe–Bolourchi; 16 Hermite elements, F = 300 and 600 e_z):
 //   every sample against the shooting solution of the rod equations
-//   (beam_rod_shooting.hpp) integrated to the sample's arc length. Forces
+//   (workflows/study/references/rod_shooting.hpp) integrated to the sample's arc length. Forces
 //   within 0.5 % of |F|, moments within 1 % of max |M|, continuous across
 //   nodes. The output before this recovery (the nearest Gauss point's C_F Γ,
 //   C_M Ω, commit f7a3c71) is computed beside it and printed: its force error
@@ -19,7 +19,7 @@
 #include "solver/beams/beam_output.hpp"
 #include "solver/beams/beam_resultants.hpp"
 #include "solver/beams/beam_term.hpp"
-#include "tests/solver/beam_rod_shooting.hpp"
+#include "workflows/study/references/rod_shooting.hpp"
 #include "tests/solver/beam_test_bodies.hpp"
 #include "tests/solver/beam_test_system.hpp"
 
@@ -34,6 +34,7 @@ using namespace stentsim;
 using namespace stentsim::solver;
 using namespace stentsim::solver::beams;
 using namespace stentsim::solver::beams::testing;
+using namespace stentsim::study::reference;
 
 namespace {
 

@@ -26,7 +26,7 @@
 #include "common/summary.hpp"
 #include "solver/app/solve.hpp"
 #include "solver/beams/section.hpp"
-#include "tests/solver/beam_rod_shooting.hpp"
+#include "workflows/study/references/rod_shooting.hpp"
 #include "tests/workflows/cli_runner.hpp"
 
 namespace stentsim::solver {
@@ -65,7 +65,7 @@ double num(const Summary& s, const std::string& name) { return std::get<double>(
 std::array<Eigen::Vector3d, 3> bend_reference() {
   const double R = 100.0, L = R * std::numbers::pi / 4;
   const auto sec = beams::BeamSection::from_values(1e7, 5e6, 1, 1, 1, 1.0 / 12, 1.0 / 12, 1.0 / 6);
-  beams::testing::RodProblem p;
+  study::reference::RodProblem p;
   p.length = L;
   p.CF = sec.CF;
   p.CM = sec.CM;
@@ -78,7 +78,7 @@ std::array<Eigen::Vector3d, 3> bend_reference() {
   int k = 0;
   for (int i = 1; i <= 60; ++i) {
     const double f = 10.0 * i;
-    const auto end = beams::testing::rod_shoot(p, Eigen::Vector3d(0, 0, f), m0);
+    const auto end = study::reference::rod_shoot(p, Eigen::Vector3d(0, 0, f), m0);
     if (f == 300 || f == 450 || f == 600) tips[static_cast<std::size_t>(k++)] = end.r;
   }
   return tips;

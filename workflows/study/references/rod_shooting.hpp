@@ -7,7 +7,7 @@
 // by Newton (finite-difference Jacobian). Integration: classical RK4 on
 // (r, q, m) with the quaternion ODE q' = ½ q ⊗ (0, κ), renormalized each step.
 // Independent of the finite-element code on purpose: the solver's beam tests
-// (tests/solver/beam_bend45_test.cpp, via tests/solver/beam_rod_shooting.hpp)
+// (tests/solver/beam_bend45_test.cpp, beam_resultant_output_test.cpp, beam_scene_test.cpp)
 // and the error study measure against the same numbers.
 //
 // Header-only, like tube_reference.hpp, so that the solver tests use it
