@@ -146,3 +146,103 @@ TEST(Plots, ConcurrentCallersAreSerialized) {
   EXPECT_TRUE(doc.load_file((dir / "t2.svg").c_str()));
   fs::remove_all(dir);
 }
+
+// Issue 11 review: a log axis inside one decade (wall times 2-6 s) had no numbers.
+TEST(Plots, LogAxisTicksLabelRangesInsideOneDecade) {
+  const auto in_range = [](const std::vector<Tick>& t, double lo, double hi) {
+    for (const auto& k : t)
+      if (k.value < lo * (1 - 1e-9) || k.value > hi * (1 + 1e-9) || k.label.empty()) return false;
+    return true;
+  };
+  const auto t = log_axis_ticks(2.1, 5.5);
+  ASSERT_GE(t.size(), 2u);
+  EXPECT_TRUE(in_range(t, 2.1, 5.5));
+  EXPECT_EQ(t.front().label, "3");
+  EXPECT_EQ(t.back().label, "5");
+
+  const auto tube = log_axis_ticks(1.2, 8.7);  // the tube study's wall times
+  EXPECT_GE(tube.size(), 3u);
+  EXPECT_TRUE(in_range(tube, 1.2, 8.7));
+
+  const auto narrow = log_axis_ticks(2.1, 2.9);  // between two integer mantissas
+  ASSERT_GE(narrow.size(), 2u);
+  EXPECT_TRUE(in_range(narrow, 2.1, 2.9));
+  EXPECT_EQ(narrow.front().label, "2.2");
+
+  const auto two_decades = log_axis_ticks(0.04, 3.0);  // 1-2-5 steps: 0.05 0.1 0.2 0.5 1 2
+  ASSERT_EQ(two_decades.size(), 6u);
+  EXPECT_EQ(two_decades[0].label, "0.05");
+  EXPECT_EQ(two_decades[5].label, "2");
+
+  const auto many = log_axis_ticks(1e-9, 1e3);  // 13 decades: thinned to <= 8, whole decades
+  EXPECT_GE(many.size(), 3u);
+  EXPECT_LE(many.size(), 8u);
+  EXPECT_EQ(many.front().label, "10#u-9#d");
+  EXPECT_EQ(log_axis_ticks(1.5e-5, 9e-5).front().label, "2×10#u-5#d");
+
+  EXPECT_THROW(log_axis_ticks(0.0, 1.0), InputError);
+  EXPECT_THROW(log_axis_ticks(2.0, 1.0), InputError);
+}
+
+namespace {
+// Number of glyphs cairo placed in an SVG (each drawn character is a <use>).
+std::size_t svg_glyphs(const fs::path& svg) {
+  pugi::xml_document doc;
+  if (!doc.load_file(svg.c_str())) return 0;
+  std::size_t n = 0;
+  for (auto u : doc.select_nodes("//*[local-name()='use']")) (void)u, ++n;
+  return n;
+}
+}  // namespace
+
+TEST(Plots, LogAxisInsideOneDecadeIsNumberedInTheImage) {
+  // The same figure with x in 2.1-5.5 and in 2100-5500: every x tick label
+  // gains three zeros ("3" -> "3000"), so the SVG must hold 3 more glyphs per
+  // label. Without numbers on the axis (PLplot's decade-only labels) the two
+  // images would have the same number of glyphs.
+  const auto dir = fresh_dir("logticks");
+  Figure f;
+  f.title = "error vs wall time";
+  f.x = {"wall time", "s", true, {}, {}, {}};
+  f.y = {"error", "mm", true, {}, {}, {}};
+  f.series.push_back({"hex8", {2.1, 3.3, 5.5}, {1e-2, 3e-3, 1e-3}, Style::lines_and_markers, Marker::automatic});
+  write_svg(f, dir / "small.svg");
+  const auto n_labels = log_axis_ticks(std::pow(10.0, std::log10(2.1) - 0.05 * std::log10(5.5 / 2.1)),
+                                       std::pow(10.0, std::log10(5.5) + 0.05 * std::log10(5.5 / 2.1)))
+                            .size();
+  ASSERT_GE(n_labels, 2u);
+  for (auto& x : f.series[0].x) x *= 1000;
+  write_svg(f, dir / "large.svg");
+  const auto small = svg_glyphs(dir / "small.svg"), large = svg_glyphs(dir / "large.svg");
+  ASSERT_GT(small, 0u) << "cairo writes text as <use> glyph references";
+  EXPECT_EQ(large - small, 3 * n_labels);
+  fs::remove_all(dir);
+}
+
+TEST(Plots, FitTitleWrapsShrinksOrCuts) {
+  const auto width = [](const TitleLayout& t) {
+    std::size_t n = 0;
+    for (const auto& l : t.lines) n = std::max(n, l.size());
+    return static_cast<double>(n) * t.scale;
+  };
+  const auto fits = fit_title("short title", 40);
+  ASSERT_EQ(fits.lines.size(), 1u);
+  EXPECT_EQ(fits.lines[0], "short title");
+  EXPECT_EQ(fits.scale, 1.0);
+
+  // The tube study's title: longer than the page, wrapped at a middle space.
+  const std::string tube = "tube: error of inner_radius_at_pmax against h (hex8, tet10, tet10-curved)";
+  const auto wrapped = fit_title(tube, 50);
+  ASSERT_EQ(wrapped.lines.size(), 2u);
+  EXPECT_EQ(wrapped.lines[0] + " " + wrapped.lines[1], tube) << "nothing lost";
+  EXPECT_LE(width(wrapped), 50.0);
+
+  const auto shrunk = fit_title(tube, 32);  // halves of ~37 glyphs shrink to fit
+  EXPECT_LT(shrunk.scale, 1.0);
+  EXPECT_GE(shrunk.scale, 0.7);
+  EXPECT_LE(width(shrunk), 32.0 + 1e-9);
+
+  const auto cut = fit_title(std::string(200, 'x'), 30);  // no space to break at
+  EXPECT_LE(width(cut), 30.0 + 1e-9);
+  EXPECT_NE(cut.lines[0].find("..."), std::string::npos);
+}

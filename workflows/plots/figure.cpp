@@ -217,6 +217,22 @@ void draw_legend(const std::vector<LegendEntry>& entries) {
   plschr(0.0, 1.0);
 }
 
+// Title metrics in default character heights: a glyph is ~0.75 heights wide
+// in the cairo font at worst (digits, capitals); lines 1.6 heights apart, the
+// lowest 2 heights above the plot (where pllab puts a title).
+constexpr double title_glyph_w = 0.75, title_gap = 1.6, title_disp = 2.0;
+
+// Writes the title lines centred on the page (not the viewport, which is
+// narrowed by the legend), so a long title uses the whole width.
+void draw_title(const TitleLayout& t, double vx0, double vx1) {
+  const double centre = (0.5 - vx0) / (vx1 - vx0);
+  plschr(0.0, t.scale);
+  const auto n = t.lines.size();
+  for (std::size_t i = 0; i < n; ++i)
+    plmtex("t", title_disp + title_gap * static_cast<double>(n - 1 - i), centre, 0.5, plain(t.lines[i]).c_str());
+  plschr(0.0, 1.0);
+}
+
 void render(const Figure& f, const char* device, const std::filesystem::path& file) {
   Range xr, yr;
   auto collect = [&](const std::vector<double>& x, const std::vector<double>& y) {
@@ -281,30 +297,50 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
   const double tick_disp = 0.7;  // gap between axis and category names, in character heights
   const double names_ht = 0.62 * static_cast<double>(longest_tick) + tick_disp;
   const double bottom = categorical ? std::min(0.6, (names_ht + 3.0) * char_ht / page_h) : 0.12;
-  plvpor(0.11, right, bottom, 0.91);
+  // The title may take two lines (fit_title); the plot top moves down for it.
+  const double vx0 = 0.11, vx1 = right;
+  const TitleLayout title = fit_title(f.title, 0.94 * page_w / (title_glyph_w * char_ht));
+  const double title_ht = (title_disp + title_gap * static_cast<double>(title.lines.size() - 1) + 1.0) *
+                          title.scale * char_ht / page_h;
+  plvpor(vx0, vx1, bottom, std::min(0.91, 1.0 - title_ht - 0.01));
   plwind(x0, x1, y0, y1);
 
-  // Grid first (under the data), then the frame, ticks and numbers.
+  // Grid first (under the data), then the frame, ticks and numbers. A log
+  // axis gets its numbers (and grid lines) from log_axis_ticks: PLplot's own
+  // log labels sit on whole decades only and vanish inside one decade.
+  const std::vector<Tick> xticks =
+      f.x.log && !categorical ? log_axis_ticks(std::pow(10.0, x0), std::pow(10.0, x1)) : std::vector<Tick>{};
+  const std::vector<Tick> yticks =
+      f.y.log ? log_axis_ticks(std::pow(10.0, y0), std::pow(10.0, y1)) : std::vector<Tick>{};
   plcol0(grid);
   plwidth(0.5);
-  const std::string xlog = f.x.log ? "l" : "";
-  const std::string ylog = f.y.log ? "l" : "";
-  plbox(("g" + xlog).c_str(), categorical ? 1.0 : 0.0, categorical ? 1 : 0, ("g" + ylog).c_str(), 0.0, 0);
+  plbox(f.x.log ? "" : "g", categorical ? 1.0 : 0.0, categorical ? 1 : 0, f.y.log ? "" : "g", 0.0, 0);
+  for (const auto& t : xticks) pljoin(std::log10(t.value), y0, std::log10(t.value), y1);
+  for (const auto& t : yticks) pljoin(x0, std::log10(t.value), x1, std::log10(t.value));
   plcol0(ink);
   plwidth(1.0);
+  const std::string xlog = f.x.log ? "l" : "";
+  const std::string ylog = f.y.log ? "l" : "";
+  const std::string ynum = f.y.log ? "" : "n";
+  for (const auto& t : xticks)
+    plmtex("b", 1.5, (std::log10(t.value) - x0) / (x1 - x0), 0.5, t.label.c_str());
+  for (const auto& t : yticks)
+    plmtex("lv", 0.5, (std::log10(t.value) - y0) / (y1 - y0), 1.0, t.label.c_str());
   if (categorical) {
-    plbox("bct", 1.0, 1, ("bcnstv" + ylog).c_str(), 0.0, 0);
+    plbox("bct", 1.0, 1, ("bcstv" + ynum + ylog).c_str(), 0.0, 0);
     // Category names perpendicular to the bottom edge, ending at the axis.
     for (std::size_t i = 0; i < f.x.tick_labels.size(); ++i) {
       const double pos = (static_cast<double>(i) - x0) / (x1 - x0);
       plmtex("bv", tick_disp, pos, 1.0, plain(f.x.tick_labels[i]).c_str());
     }
     plmtex("b", names_ht + 1.8, 0.5, 0.5, plain(axis_title(f.x)).c_str());
-    pllab("", plain(axis_title(f.y)).c_str(), plain(f.title).c_str());
+    pllab("", plain(axis_title(f.y)).c_str(), "");
   } else {
-    plbox(("bcnst" + xlog).c_str(), 0.0, 0, ("bcnstv" + ylog).c_str(), 0.0, 0);
-    pllab(plain(axis_title(f.x)).c_str(), plain(axis_title(f.y)).c_str(), plain(f.title).c_str());
+    plbox(("bcst" + std::string(f.x.log ? "" : "n") + xlog).c_str(), 0.0, 0,
+          ("bcstv" + ynum + ylog).c_str(), 0.0, 0);
+    pllab(plain(axis_title(f.x)).c_str(), plain(axis_title(f.y)).c_str(), "");
   }
+  draw_title(title, vx0, vx1);
 
   std::vector<LegendEntry> highlight_legend;
   auto draw_highlight = [&](const Highlight& h) {
@@ -397,6 +433,115 @@ void write_with(const Figure& figure, const char* device, const std::filesystem:
 }
 
 }  // namespace
+
+namespace {
+
+// "0.02", "5000" within 1e-3..1e4; else "2×10⁻⁵" in PLplot's superscript syntax.
+std::string tick_text(double v) {
+  char buf[64];
+  const double a = std::abs(v);
+  if (a >= 1e-3 * (1 - 1e-9) && a < 1e4) {
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+  }
+  int k = static_cast<int>(std::floor(std::log10(a) + 1e-9));
+  double m = v / std::pow(10.0, k);
+  std::snprintf(buf, sizeof buf, "%.3g", m);
+  const std::string exp = "10#u" + std::to_string(k) + "#d";
+  return std::abs(m - 1.0) < 1e-9 ? exp : std::string(buf) + "×" + exp;
+}
+
+// The smallest 1-2-5 x 10^j step at least `raw`.
+double nice_step(double raw) {
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * p >= raw * (1 - 1e-12)) return m * p;
+  return 10.0 * p;
+}
+
+}  // namespace
+
+std::vector<Tick> log_axis_ticks(double lo, double hi) {
+  if (!(lo > 0) || !(hi > lo) || !std::isfinite(hi))
+    throw InputError("log axis ticks: need 0 < lo < hi, got lo = " + std::to_string(lo) +
+                     ", hi = " + std::to_string(hi));
+  const double tol = 1e-9;  // a tick exactly on the range end counts
+  const int k0 = static_cast<int>(std::floor(std::log10(lo))) - 1;
+  const int k1 = static_cast<int>(std::ceil(std::log10(hi))) + 1;
+  auto pick = [&](std::initializer_list<int> mantissas) {
+    std::vector<Tick> t;
+    for (int k = k0; k <= k1; ++k)
+      for (int m : mantissas) {
+        const double v = m * std::pow(10.0, k);
+        if (v >= lo * (1 - tol) && v <= hi * (1 + tol)) t.push_back({v, tick_text(v)});
+      }
+    return t;
+  };
+  auto decades = pick({1});
+  if (decades.size() >= 3) {
+    // Many decades: keep every n-th so that at most 8 are labelled.
+    const std::size_t every = (decades.size() + 7) / 8;
+    std::vector<Tick> thinned;
+    for (std::size_t i = 0; i < decades.size(); i += every) thinned.push_back(decades[i]);
+    return thinned;
+  }
+  auto one_two_five = pick({1, 2, 5});
+  if (one_two_five.size() >= 3) return one_two_five;
+  auto all = pick({1, 2, 3, 4, 5, 6, 7, 8, 9});
+  if (all.size() >= 2) return all;
+  // Narrower than the gap between two integer mantissas: linear 1-2-5 steps.
+  const double step = nice_step((hi - lo) / 4.0);
+  std::vector<Tick> t;
+  for (double i = std::ceil(lo / step * (1 - tol)); i * step <= hi * (1 + tol); i += 1.0)
+    t.push_back({i * step, tick_text(i * step)});
+  return t;
+}
+
+TitleLayout fit_title(const std::string& title, double width_chars) {
+  // Length in glyphs (UTF-8 continuation bytes do not count).
+  auto glyphs = [](const std::string& s) {
+    double n = 0;
+    for (unsigned char c : s) n += (c & 0xC0) != 0x80 ? 1.0 : 0.0;
+    return n;
+  };
+  TitleLayout out;
+  if (glyphs(title) <= width_chars || width_chars <= 0) {
+    out.lines = {title};
+    return out;
+  }
+  // Two lines, broken at the space nearest the middle.
+  std::size_t best = std::string::npos;
+  const double mid = static_cast<double>(title.size()) / 2.0;
+  for (std::size_t i = 0; i < title.size(); ++i)
+    if (title[i] == ' ' &&
+        (best == std::string::npos || std::abs(static_cast<double>(i) - mid) < std::abs(static_cast<double>(best) - mid)))
+      best = i;
+  if (best != std::string::npos)
+    out.lines = {title.substr(0, best), title.substr(best + 1)};
+  else
+    out.lines = {title};
+  double longest = 0;
+  for (const auto& l : out.lines) longest = std::max(longest, glyphs(l));
+  constexpr double min_scale = 0.7;
+  out.scale = std::min(1.0, std::max(min_scale, width_chars / longest));
+  // Still too long at the smallest size: cut each line with "...".
+  const auto room = static_cast<std::size_t>(std::floor(width_chars / out.scale));
+  for (auto& l : out.lines)
+    if (glyphs(l) > width_chars / out.scale) {
+      std::string cut;
+      double n = 0;
+      for (std::size_t i = 0; i < l.size(); ++i) {
+        const unsigned char c = static_cast<unsigned char>(l[i]);
+        if ((c & 0xC0) != 0x80) {
+          if (n + 1 > static_cast<double>(room) - 3) break;
+          n += 1;
+        }
+        cut += l[i];
+      }
+      l = cut + "...";
+    }
+  return out;
+}
 
 std::string axis_title(const Axis& axis) {
   return axis.unit.empty() ? axis.label : axis.label + " [" + axis.unit + "]";

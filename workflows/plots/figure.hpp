@@ -60,6 +60,34 @@ struct Figure {
   bool legend = true;
 };
 
+/// A labelled tick: where (in data units) and the text written there.
+struct Tick {
+  double value;
+  std::string label;
+};
+
+/// Labelled ticks for a base-10 log axis shown over [lo, hi] (data units,
+/// 0 < lo < hi). PLplot's own log axes number whole decades only, so an axis
+/// inside one decade (wall times of 2-6 s) would carry no numbers at all.
+/// This picks the sparsest of 1x10^k, {1,2,5}x10^k, {1..9}x10^k that gives at
+/// least two ticks in range (thinning whole decades when there are too many);
+/// if even {1..9}x10^k gives fewer than two, it falls back to evenly spaced
+/// 1-2-5 steps inside the range. Labels are plain decimals ("0.02", "5000")
+/// within 1e-3..1e4, otherwise mantissa x 10^k in PLplot's superscript syntax.
+std::vector<Tick> log_axis_ticks(double lo, double hi);
+
+/// How a title is laid out above the plot.
+struct TitleLayout {
+  std::vector<std::string> lines;  ///< one or two lines
+  double scale = 1.0;              ///< character height relative to the default
+};
+
+/// Fits `title` into `width_chars` default-size character widths: unchanged
+/// when it fits; else broken into two lines at the space nearest the middle;
+/// then shrunk (not below 0.7); and as a last resort cut with "...".
+/// Every returned line times `scale` is at most `width_chars` wide.
+TitleLayout fit_title(const std::string& title, double width_chars);
+
 /// "label [unit]" (or just the label when the unit is empty).
 std::string axis_title(const Axis& axis);
 
