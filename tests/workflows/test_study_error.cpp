@@ -647,3 +647,30 @@ TEST(StudyRunner, RowsFromAnotherHostAreRecomputedUnlessReuseTimings) {
   EXPECT_EQ(read(result).find("another-machine-"), std::string::npos);
   fs::remove_all(d);
 }
+
+TEST(StudyReport, FittedOrderLineSharesItsSeriesColourAndIsInTheLegend) {
+  // Issue 11 review: the fit lines took the next palette colour and had no
+  // legend entry. Each fit must be dashed, in its markers' colour, and named
+  // "<line> fit p = <order>".
+  const StudyConfig s = load_study(fs::path(STENTSIM_TEST_SOURCE_DIR) / "examples/studies/tube.yaml");
+  const StudyPlan plan = plan_study(s);
+  const StudyOutcome o = evaluate_study(s, plan, synthetic_results(s, plan, "h", 3.0));
+  const plots::Figure f = error_vs_h_figure(s, o);
+  int fits = 0;
+  std::set<int> colours;
+  for (std::size_t i = 0; i < f.series.size(); ++i) {
+    const auto& ser = f.series[i];
+    if (!ser.dashed) {
+      EXPECT_EQ(ser.style, plots::Style::markers);
+      EXPECT_TRUE(colours.insert(ser.colour).second) << "each line its own colour: " << ser.label;
+      continue;
+    }
+    ++fits;
+    ASSERT_GT(i, 0u);
+    const auto& data = f.series[i - 1];
+    EXPECT_EQ(ser.colour, data.colour) << ser.label;
+    EXPECT_GE(ser.colour, 0);
+    EXPECT_EQ(ser.label.rfind(data.label + " fit p = ", 0), 0u) << ser.label;
+  }
+  EXPECT_GE(fits, 3) << "hex8, tet10, tet10-curved lines along h";
+}

@@ -187,7 +187,11 @@ struct LegendEntry {
   PLINT colour;
   std::string symbol;
   PLFLT symbol_scale;
+  PLINT line_style = 1;  // PLplot pllsty number
 };
+
+// PLplot's line style 3: long dashes, readable at 2 px width.
+constexpr PLINT dashed_style = 3;
 
 void draw_legend(const std::vector<LegendEntry>& entries) {
   const auto n = static_cast<PLINT>(entries.size());
@@ -198,7 +202,7 @@ void draw_legend(const std::vector<LegendEntry>& entries) {
     opts.push_back(e.opt);
     text_colours.push_back(ink);
     line_colours.push_back(e.colour);
-    line_styles.push_back(1);
+    line_styles.push_back(e.line_style);
     line_widths.push_back(2.0);
     symbol_colours.push_back(e.colour);
     symbol_scales.push_back(e.symbol_scale);
@@ -297,8 +301,30 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
   const double tick_disp = 0.7;  // gap between axis and category names, in character heights
   const double names_ht = 0.62 * static_cast<double>(longest_tick) + tick_disp;
   const double bottom = categorical ? std::min(0.6, (names_ht + 3.0) * char_ht / page_h) : 0.12;
+  // Log-axis numbers (log_axis_ticks). The y title moves out past the
+  // longest number ("5×10⁻⁴" is wider than PLplot's own labels), and the
+  // plot's left edge with it.
+  const std::vector<Tick> xticks =
+      f.x.log && !categorical ? log_axis_ticks(std::pow(10.0, x0), std::pow(10.0, x1)) : std::vector<Tick>{};
+  const std::vector<Tick> yticks =
+      f.y.log ? log_axis_ticks(std::pow(10.0, y0), std::pow(10.0, y1)) : std::vector<Tick>{};
+  double longest_y = 0;
+  for (const auto& t : yticks) {
+    double n = 0;
+    for (std::size_t i = 0; i < t.label.size(); ++i) {
+      const unsigned char c = static_cast<unsigned char>(t.label[i]);
+      if (c == '#') {  // "#u" / "#d": no glyph
+        ++i;
+        continue;
+      }
+      if ((c & 0xC0) != 0x80) n += 1;
+    }
+    longest_y = std::max(longest_y, n);
+  }
+  const double ytitle_disp = std::max(5.0, 0.75 * longest_y + 1.8);
   // The title may take two lines (fit_title); the plot top moves down for it.
-  const double vx0 = 0.11, vx1 = right;
+  const double vx0 = std::max(0.11, (ytitle_disp + 1.0) * char_ht / page_w);
+  const double vx1 = right;
   const TitleLayout title = fit_title(f.title, 0.94 * page_w / (title_glyph_w * char_ht));
   const double title_ht = (title_disp + title_gap * static_cast<double>(title.lines.size() - 1) + 1.0) *
                           title.scale * char_ht / page_h;
@@ -308,10 +334,6 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
   // Grid first (under the data), then the frame, ticks and numbers. A log
   // axis gets its numbers (and grid lines) from log_axis_ticks: PLplot's own
   // log labels sit on whole decades only and vanish inside one decade.
-  const std::vector<Tick> xticks =
-      f.x.log && !categorical ? log_axis_ticks(std::pow(10.0, x0), std::pow(10.0, x1)) : std::vector<Tick>{};
-  const std::vector<Tick> yticks =
-      f.y.log ? log_axis_ticks(std::pow(10.0, y0), std::pow(10.0, y1)) : std::vector<Tick>{};
   plcol0(grid);
   plwidth(0.5);
   plbox(f.x.log ? "" : "g", categorical ? 1.0 : 0.0, categorical ? 1 : 0, f.y.log ? "" : "g", 0.0, 0);
@@ -334,11 +356,12 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
       plmtex("bv", tick_disp, pos, 1.0, plain(f.x.tick_labels[i]).c_str());
     }
     plmtex("b", names_ht + 1.8, 0.5, 0.5, plain(axis_title(f.x)).c_str());
-    pllab("", plain(axis_title(f.y)).c_str(), "");
+    plmtex("l", ytitle_disp, 0.5, 0.5, plain(axis_title(f.y)).c_str());
   } else {
     plbox(("bcst" + std::string(f.x.log ? "" : "n") + xlog).c_str(), 0.0, 0,
           ("bcstv" + ynum + ylog).c_str(), 0.0, 0);
-    pllab(plain(axis_title(f.x)).c_str(), plain(axis_title(f.y)).c_str(), "");
+    pllab(plain(axis_title(f.x)).c_str(), "", "");
+    plmtex("l", ytitle_disp, 0.5, 0.5, plain(axis_title(f.y)).c_str());
   }
   draw_title(title, vx0, vx1);
 
@@ -378,12 +401,15 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
     if (h.beneath_series) draw_highlight(h);
   for (std::size_t i = 0; i < f.series.size(); ++i) {
     const auto& s = f.series[i];
-    const PLINT colour = first_series + static_cast<PLINT>(i % n_series);
-    const std::string symbol = glyph(resolve(s.marker, i));
+    const std::size_t slot = s.colour >= 0 ? static_cast<std::size_t>(s.colour) : i;
+    const PLINT colour = first_series + static_cast<PLINT>(slot % n_series);
+    const std::string symbol = glyph(resolve(s.marker, slot));
     plcol0(colour);
     if (s.style != Style::markers) {
       plwidth(2.0);
+      if (s.dashed) pllsty(dashed_style);
       draw_lines(s.x, s.y, f);
+      pllsty(1);
       plwidth(1.0);
     }
     if (s.style != Style::lines) draw_markers(s.x, s.y, f, symbol.c_str());
@@ -391,7 +417,7 @@ void render(const Figure& f, const char* device, const std::filesystem::path& fi
       PLINT opt = 0;
       if (s.style != Style::markers) opt |= PL_LEGEND_LINE;
       if (s.style != Style::lines) opt |= PL_LEGEND_SYMBOL;
-      legend.push_back({s.label, opt, colour, symbol, 1.0});
+      legend.push_back({s.label, opt, colour, symbol, 1.0, s.dashed ? dashed_style : 1});
     }
   }
   for (const auto& h : f.highlights)

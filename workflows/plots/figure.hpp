@@ -25,6 +25,10 @@ struct Series {
   std::vector<double> y;
   Style style = Style::lines;
   Marker marker = Marker::automatic;
+  /// Palette slot (0-9); -1 = the series' position. Series sharing a slot
+  /// share colour and automatic marker (e.g. data and its fitted line).
+  int colour = -1;
+  bool dashed = false;  ///< dashed line (a fit or a guide, not data)
 };
 
 /// Points drawn on top of every series, larger and outlined (e.g. a Pareto

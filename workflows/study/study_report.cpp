@@ -237,6 +237,48 @@ StudyOutcome evaluate_study(const StudyConfig& s, const StudyPlan& plan, const s
   return o;
 }
 
+plots::Figure error_vs_h_figure(const StudyConfig& s, const StudyOutcome& o) {
+  plots::Figure f;
+  f.title = fmt::format("{}: error of {} against mesh size", s.name, s.qoi);
+  f.x = {"h", "mm", true, std::nullopt, std::nullopt, {}};
+  f.y = {o.relative_error ? "relative error" : "error", "", true, std::nullopt, std::nullopt, {}};
+  int slot = 0;  // one colour (and marker) per line, shared by its fit
+  for (const auto& line : o.lines) {
+    if (line.h.empty() || !std::isfinite(line.h.front())) continue;
+    plots::Series ser{line.label, {}, {}, plots::Style::markers, plots::Marker::automatic};
+    ser.colour = slot;
+    for (std::size_t j = 0; j < line.h.size(); ++j) {
+      if (!(std::isfinite(line.error[j]) && line.error[j] > 0)) continue;
+      ser.x.push_back(line.h[j]);
+      ser.y.push_back(line.error[j]);
+    }
+    if (ser.x.empty()) continue;
+    ++slot;
+    if (line.fitted_order && ser.x.size() >= 2) {
+      // The fitted power law e = C h^p through the points' geometric mean,
+      // dashed in the line's colour, in the legend with its order.
+      double lx = 0, ly = 0;
+      for (std::size_t j = 0; j < ser.x.size(); ++j) {
+        lx += std::log(ser.x[j]);
+        ly += std::log(ser.y[j]);
+      }
+      lx /= static_cast<double>(ser.x.size());
+      ly /= static_cast<double>(ser.x.size());
+      const auto [mn, mx] = std::minmax_element(ser.x.begin(), ser.x.end());
+      plots::Series fit{fmt::format("{} fit p = {:.2f}", line.label, *line.fitted_order), {*mn, *mx}, {},
+                        plots::Style::lines, plots::Marker::automatic};
+      fit.colour = ser.colour;
+      fit.dashed = true;
+      for (double x : fit.x) fit.y.push_back(std::exp(ly + *line.fitted_order * (std::log(x) - lx)));
+      f.series.push_back(std::move(ser));
+      f.series.push_back(std::move(fit));
+    } else {
+      f.series.push_back(std::move(ser));
+    }
+  }
+  return f;
+}
+
 ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std::vector<RunResult>& results, const StudyOutcome& o,
                          const fs::path& out_dir) {
   ReportFiles files;
@@ -322,41 +364,8 @@ ReportFiles write_report(const StudyConfig& s, const StudyPlan& plan, const std:
     }
   }
   {
-    plots::Figure f;
-    f.title = fmt::format("{}: error of {} against mesh size", s.name, s.qoi);
-    f.x = {"h", "mm", true, std::nullopt, std::nullopt, {}};
-    f.y = {o.relative_error ? "relative error" : "error", "", true, std::nullopt, std::nullopt, {}};
-    bool any = false;
-    for (const auto& line : o.lines) {
-      if (line.h.empty() || !std::isfinite(line.h.front())) continue;
-      plots::Series ser{line.fitted_order ? fmt::format("{} (p = {:.2f})", line.label, *line.fitted_order) : line.label, {}, {},
-                        plots::Style::markers, plots::Marker::automatic};
-      std::vector<double> hs, es;
-      for (std::size_t j = 0; j < line.h.size(); ++j) {
-        if (!std::isfinite(positive(line.error[j]))) continue;
-        ser.x.push_back(line.h[j]);
-        ser.y.push_back(line.error[j]);
-      }
-      if (ser.x.empty()) continue;
-      any = true;
-      if (line.fitted_order && ser.x.size() >= 2) {
-        // The fitted power law e = C h^p through the points' geometric mean.
-        double lx = 0, ly = 0;
-        for (std::size_t j = 0; j < ser.x.size(); ++j) {
-          lx += std::log(ser.x[j]);
-          ly += std::log(ser.y[j]);
-        }
-        lx /= static_cast<double>(ser.x.size());
-        ly /= static_cast<double>(ser.x.size());
-        const auto [mn, mx] = std::minmax_element(ser.x.begin(), ser.x.end());
-        plots::Series fit{"", {*mn, *mx}, {}, plots::Style::lines, plots::Marker::automatic};
-        for (double x : fit.x) fit.y.push_back(std::exp(ly + *line.fitted_order * (std::log(x) - lx)));
-        f.series.push_back(std::move(ser));
-        f.series.push_back(std::move(fit));
-      } else {
-        f.series.push_back(std::move(ser));
-      }
-    }
+    const plots::Figure f = error_vs_h_figure(s, o);
+    const bool any = !f.series.empty();
     if (any) {
       for (const char* ext : {".png", ".svg"}) {
         const fs::path p = out_dir / (std::string("error_vs_h") + ext);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "workflows/plots/figure.hpp"
 #include "workflows/study/convergence.hpp"
 #include "workflows/study/run_executor.hpp"
 #include "workflows/study/study_config.hpp"
@@ -54,6 +55,11 @@ std::size_t edit_distance(const std::string& a, const std::string& b);
 /// not fit its QoI (component count). A relative error against a reference
 /// that vanishes (kVanishingQoi) is reported as absolute, with error_note.
 StudyOutcome evaluate_study(const StudyConfig& study, const StudyPlan& plan, const std::vector<RunResult>& results);
+
+/// The error-against-h figure: per line with mesh sizes, its errors as
+/// markers and, when an order was fitted, the fitted power law as a dashed
+/// line of the same colour labelled "<line> fit p = <order>".
+plots::Figure error_vs_h_figure(const StudyConfig& study, const StudyOutcome& outcome);
 
 /// Files written into `out_dir`.
 struct ReportFiles {
