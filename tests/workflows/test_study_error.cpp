@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "common/summary.hpp"
 #include "tests/workflows/cli_runner.hpp"
 #include "workflows/study/analytic_references.hpp"
 #include "workflows/study/convergence.hpp"
@@ -251,6 +252,29 @@ TEST(StudyRunner, WritesCsvMarkdownAndPlots) {
   const std::string md = read(o.out_dir / "study.md");
   EXPECT_NE(md.find("Cheapest within tolerance"), std::string::npos);
   EXPECT_NE(md.find("Pareto front"), std::string::npos);
+
+  // summary.yaml like every other tool: counts, orders, cheapest run, time and memory.
+  const auto sum = stentsim::Summary::read(o.out_dir / "summary.yaml");
+  auto q = [&](const std::string& name) -> const stentsim::Qoi* {
+    const auto it = sum.qois().find(name);
+    return it == sum.qois().end() ? nullptr : &it->second;
+  };
+  ASSERT_NE(q("runs"), nullptr);
+  EXPECT_EQ(std::get<double>(q("runs")->value), 3.0);
+  EXPECT_EQ(std::get<double>(q("runs_failed")->value), 0.0);
+  EXPECT_EQ(std::get<double>(q("runs_executed")->value) + std::get<double>(q("runs_cached")->value), 3.0);
+  ASSERT_NE(q("cheapest_run"), nullptr);
+  EXPECT_EQ(std::get<std::string>(q("cheapest_run")->value), r.plan.runs[*r.outcome.cheapest].label);
+  ASSERT_NE(q("cheapest_wall_time"), nullptr);
+  EXPECT_EQ(q("cheapest_wall_time")->unit, "s");
+  int orders = 0;
+  for (const auto& [name, v] : sum.qois())
+    if (name.rfind("fitted_order.", 0) == 0) ++orders;
+  int fitted = 0;
+  for (const auto& l : r.outcome.lines) fitted += l.fitted_order ? 1 : 0;
+  EXPECT_EQ(orders, fitted);
+  EXPECT_GT(sum.wall_time_s(), 0.0);
+  EXPECT_GT(sum.peak_memory_mb(), 0.0);
   fs::remove_all(d);
 }
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <ostream>
@@ -40,6 +41,46 @@ double estimate_seconds(const StudyConfig& s, const StudyPlan& plan, std::size_t
     }
   }
   return best;
+}
+
+Summary error_study_summary(const StudyConfig& study, const ErrorStudyResult& r) {
+  Summary sum;
+  const auto n = static_cast<double>(r.plan.runs.size());
+  sum.set("runs", n);
+  sum.set("runs_executed", static_cast<double>(r.stats.executed));
+  sum.set("runs_cached", static_cast<double>(r.stats.cached));
+  sum.set("runs_failed", static_cast<double>(r.stats.failed));
+  // Observed orders per refinement line; the label made a plain key
+  // ("h element=tet10" -> fitted_order.h_element_tet10).
+  for (const auto& l : r.outcome.lines) {
+    if (!l.fitted_order) continue;
+    std::string key;
+    for (char c : l.label) key += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
+    while (key.find("__") != std::string::npos) key.erase(key.find("__"), 1);
+    while (!key.empty() && key.back() == '_') key.pop_back();
+    sum.set("fitted_order." + key, *l.fitted_order);
+    if (l.richardson && l.richardson->ok) sum.set("richardson_order." + key, l.richardson->observed_order);
+  }
+  double min_error = std::numeric_limits<double>::quiet_NaN();
+  for (double e : r.outcome.error)
+    if (std::isfinite(e) && !(e >= min_error)) min_error = e;
+  if (std::isfinite(min_error)) sum.set("error_min", min_error);
+  if (study.tolerance) sum.set("tolerance", *study.tolerance);
+  if (r.outcome.cheapest) {
+    const std::size_t c = *r.outcome.cheapest;
+    sum.set_text("cheapest_run", r.plan.runs[c].label);
+    sum.set("cheapest_error", r.outcome.error[c]);
+    sum.set("cheapest_wall_time", r.results[c].wall_s, "s");
+  } else if (study.tolerance) {
+    sum.set_text("cheapest_run", "none within tolerance");
+  }
+  sum.note("study", study.name);
+  sum.note("qoi", study.qoi);
+  sum.note("error_kind", r.outcome.relative_error ? "relative" : "absolute");
+  sum.note("reference", r.outcome.reference_note);
+  // wall_time_s / peak_memory_mb: this process (the study driver); each
+  // run's own are in study.csv.
+  return sum;
 }
 
 int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostream& out, ErrorStudyResult* result) {
@@ -122,7 +163,8 @@ int run_error_study(const fs::path& file, const ErrorStudyOptions& o, std::ostre
   if (r.outcome.cheapest)
     out << fmt::format("cheapest within tolerance {:.3g}: {} ({:.3g} s)\n", *study.tolerance, r.plan.runs[*r.outcome.cheapest].label,
                        r.results[*r.outcome.cheapest].wall_s);
-  out << fmt::format("wrote {} and {}\n", r.files.csv.string(), r.files.markdown.string());
+  error_study_summary(study, r).write(r.out_dir / "summary.yaml");
+  out << fmt::format("wrote {}, {} and summary.yaml\n", r.files.csv.string(), r.files.markdown.string());
   return r.stats.failed > 0 ? 1 : 0;
 }
 

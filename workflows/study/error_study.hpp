@@ -5,6 +5,7 @@
 #include <iosfwd>
 #include <string>
 
+#include "common/summary.hpp"
 #include "workflows/study/run_executor.hpp"
 #include "workflows/study/study_report.hpp"
 
@@ -30,6 +31,11 @@ struct ErrorStudyResult {
   ExecStats stats;
   std::filesystem::path out_dir;
 };
+
+/// The study's summary.yaml (DESIGN.md §6): run counts (executed, cached,
+/// failed), the fitted (and Richardson) order per refinement line, the
+/// smallest error and the cheapest run within the tolerance.
+Summary error_study_summary(const StudyConfig& study, const ErrorStudyResult& result);
 
 /// Runs the study; prints progress and a summary to `out`. Returns the exit
 /// code: 0 when every run succeeded, 1 when some failed (they are in the table).

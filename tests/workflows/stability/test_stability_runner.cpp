@@ -11,6 +11,7 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/summary.hpp"
 #include "workflows/study/stability/stability_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -207,6 +208,24 @@ cases:
   EXPECT_NE(csv.find("stops,failed cleanly,yes,"), std::string::npos) << csv;
   EXPECT_NE(md.find("| crashes | crash | **no**"), std::string::npos) << md;
   EXPECT_NE(md.find("3 of 7 case(s) as expected"), std::string::npos) << md;
+
+  // summary.yaml like every other tool: counts per outcome, time and memory.
+  const auto sum = stentsim::Summary::read(o.out_dir / "summary.yaml");
+  auto q = [&](const std::string& name) {
+    const auto it = sum.qois().find(name);
+    return it == sum.qois().end() ? -1.0 : std::get<double>(it->second.value);
+  };
+  EXPECT_EQ(q("cases_total"), 7);
+  EXPECT_EQ(q("cases_as_expected"), 3);
+  EXPECT_EQ(q("cases_not_as_expected"), 4);
+  EXPECT_EQ(q("cases_converged"), 3);  // ok, near, far
+  EXPECT_EQ(q("cases_failed_cleanly"), 2);
+  EXPECT_EQ(q("cases_hang"), 1);
+  EXPECT_EQ(q("cases_crash"), 1);
+  EXPECT_EQ(q("cases_nan"), 0);
+  EXPECT_GE(q("cases_wall_time_total"), 0.5) << "the hang alone ran to its 0.5 s limit";
+  EXPECT_GT(sum.wall_time_s(), 0.0);
+  EXPECT_GT(sum.peak_memory_mb(), 0.0);
 
   o.only = {"stops"};
   EXPECT_EQ(run_stability_suite(s, o, log).cases.size(), 1u);

@@ -17,6 +17,7 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/summary.hpp"
 #include "common/mesh_data.hpp"
 #include "pipeline/manifest.hpp"
 #include "workflows/study/input_paths.hpp"
@@ -432,6 +433,32 @@ void write_stability_tables(const StabilityReport& r, const fs::path& dir) {
                       o.limit_s, md_cell(o.message));
   md += fmt::format("\n{} of {} case(s) as expected.\n", r.cases.size() - static_cast<std::size_t>(r.unexpected()), r.cases.size());
   files::write_atomic(dir / "stability.md", md);
+  stability_summary(r).write(dir / "summary.yaml");
+}
+
+Summary stability_summary(const StabilityReport& r) {
+  Summary sum;
+  sum.set("cases_total", static_cast<double>(r.cases.size()));
+  sum.set("cases_as_expected", static_cast<double>(r.cases.size()) - r.unexpected());
+  sum.set("cases_not_as_expected", static_cast<double>(r.unexpected()));
+  // Every outcome class, zeros included, so a reader never has to guess
+  // whether a missing count means none.
+  for (const char* outcome : {"converged", "failed cleanly", "failed uncleanly", "hang", "crash", "nan"}) {
+    std::string name = std::string("cases_") + outcome;
+    std::replace(name.begin(), name.end(), ' ', '_');
+    sum.set(name, static_cast<double>(std::count_if(r.cases.begin(), r.cases.end(),
+                                                    [&](const StabilityOutcome& o) { return o.outcome == outcome; })));
+  }
+  double child_wall = 0, child_mem = 0;
+  for (const auto& o : r.cases) {
+    child_wall += o.run.wall_s;
+    child_mem = std::max(child_mem, o.run.peak_memory_mb);
+  }
+  sum.set("cases_wall_time_total", child_wall, "s");
+  sum.set("case_peak_memory_max", child_mem, "MB");
+  sum.note("suite", r.suite);
+  // wall_time_s / peak_memory_mb: this process (the runner), set by Summary.
+  return sum;
 }
 
 }  // namespace stentsim::study

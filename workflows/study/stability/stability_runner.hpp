@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "common/summary.hpp"
 #include "workflows/study/stability/child_run.hpp"
 #include "workflows/study/stability/stability_suite.hpp"
 
@@ -63,7 +64,10 @@ std::string find_non_finite(const std::filesystem::path& dir);
 /// and stability.csv + stability.md into out_dir after every case.
 StabilityReport run_stability_suite(const StabilitySuite& s, const StabilityOptions& o, std::ostream& out);
 
-/// Writes stability.csv and stability.md into `dir` (atomically).
+/// The suite's summary.yaml (DESIGN.md §6): counts per outcome class, as
+/// expected or not, the cases' summed wall time and largest peak memory.
+Summary stability_summary(const StabilityReport& r);
+/// Writes stability.csv, stability.md and summary.yaml into `dir` (atomically).
 void write_stability_tables(const StabilityReport& r, const std::filesystem::path& dir);
 
 }  // namespace stentsim::study
