@@ -79,7 +79,10 @@ double section_area(const TriSurface& surface, const Eigen::Vector3d& point, con
 struct CenterlineAccuracy {
   double centerline_distance_max = 0;      // max distance / local true radius
   double inscribed_radius_error_max = 0;   // max |R − R_true| / R_true
-  double stenosis_site_error = 0;          // mm, between the narrowest points
+  /// mm, between the computed and the true narrowest points; absent when
+  /// the true centerline has no stenosis (a healthy phantom has no site to
+  /// find, and 0 there would read as a perfect result).
+  std::optional<double> stenosis_site_error;
   std::size_t points_compared = 0;
 };
 CenterlineAccuracy compare_with_true_centerline(const MeshData& computed, const MeshData& truth,

@@ -60,7 +60,8 @@ CenterlineAccuracy compare_with_true_centerline(const MeshData& computed, const 
   // Narrowest sites (computed: sub-sample parabola as in compute_centerline is
   // not needed at the 0.5 mm tolerance; the sample is within spacing/2).
   std::size_t ic = argmin(R), it = argmin(Rt);
-  // A healthy phantom has no narrowest site: compare only when the truth has one.
+  // A healthy phantom has no narrowest site: compare only when the truth has
+  // one (radius 1 % below its largest); otherwise the error stays absent.
   double rmax = *std::max_element(Rt.begin(), Rt.end());
   if (Rt[it] < 0.99 * rmax) acc.stenosis_site_error = (computed.points[ic] - pt[it]).norm();
   return acc;

@@ -62,7 +62,10 @@ void run_centerline_stage(const CenterlineOptions& options, const std::filesyste
     CenterlineAccuracy acc = compare_with_true_centerline(r.centerline, truth);
     summary.set("centerline_distance_max", acc.centerline_distance_max, "");
     summary.set("inscribed_radius_error_max", acc.inscribed_radius_error_max, "");
-    summary.set("stenosis_site_error", acc.stenosis_site_error, "mm");
+    if (acc.stenosis_site_error)
+      summary.set("stenosis_site_error", *acc.stenosis_site_error, "mm");
+    else  // absent, so a study on it fails the row instead of reading 0 as perfect
+      summary.note("stenosis_site_error", "not applicable: the true centerline has no stenosis");
     summary.note("accuracy", "relative to the local true radius, more than 2 true radii from the ends");
   }
 }

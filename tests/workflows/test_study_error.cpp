@@ -698,3 +698,30 @@ TEST(StudyReport, FittedOrderLineSharesItsSeriesColourAndIsInTheLegend) {
   }
   EXPECT_GE(fits, 3) << "hex8, tet10, tet10-curved lines along h";
 }
+
+TEST(StudyRunner, StenosisSiteErrorOnAHealthyPhantomIsAFailedRow) {
+  // The healthy phantom has no stenosis: the centerline tool leaves
+  // stenosis_site_error out of summary.yaml (it used to write 0, "perfect"),
+  // so a study asking for it gets a failed row naming the QoI.
+  const fs::path d = fresh_dir("healthy_site");
+  write(d / "phantom.yaml", "input:\n  phantom: {preset: straight-healthy, circumferential_points: 16}\n");
+  write(d / "study.yaml",
+        "name: healthy\nbase: phantom.yaml\n"
+        "commands:\n  - [segmentation, \"{input}\", --out, \"{run}\"]\n"
+        "  - [centerline, --lumen, \"{run}/lumen.vtp\", --out, \"{run}/centerline.vtp\", --true-centerline, \"{run}/centerline_true.vtp\"]\n"
+        "qoi: stenosis_site_error\nreference: {type: qoi_is_error}\nerror: absolute\n"
+        "knobs:\n  - name: points\n    key: input.phantom.circumferential_points\n    values: [16]\n");
+  ErrorStudyOptions o;
+  o.binary = STENTSIM_TEST_BINARY;
+  o.out_dir = d / "out";
+  std::ostringstream log;
+  ErrorStudyResult r;
+  EXPECT_EQ(run_error_study(d / "study.yaml", o, log, &r), 1) << log.str();
+  ASSERT_FALSE(r.results.empty());
+  for (const auto& row : r.results) {
+    EXPECT_EQ(row.status, "failed");
+    EXPECT_NE(row.message.find("stenosis_site_error"), std::string::npos) << row.message;
+    EXPECT_EQ(row.qoi.count("inscribed_radius_error_max"), 1u) << "the run itself succeeded";
+  }
+  fs::remove_all(d);
+}
