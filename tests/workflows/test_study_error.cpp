@@ -407,7 +407,9 @@ TEST(StudyRunner, MpiRunReportsMemorySummedOverRanks) {
 }
 
 TEST(StudyCli, DryRunEstimatesFromBaseTimeBeforeAnythingRan) {
-  // h knob with cost exponent 2: h 0.2 costs 4x the base's (h 0.4 by the base's own setting: 32 points).
+  // h knob with cost exponent 2, but the base has no h of its own (32 points is
+  // neither listed setting), so no run is scaled from it: each run is estimated
+  // at the base's 2 s: 3 runs (base, 16, 64 points), 6 s in all.
   const fs::path d = fresh_dir("estimate");
   phantom_study(d, "[16, 64]", "    h: [0.4, 0.2]\n    cost_exponent: 2\n");
   const auto none = stentsim::testing::run_stentsim("study error " + (d / "study.yaml").string() + " --dry-run --out " + (d / "out").string());
