@@ -164,6 +164,11 @@ TEST(Plots, LogAxisTicksLabelRangesInsideOneDecade) {
   EXPECT_GE(tube.size(), 3u);
   EXPECT_TRUE(in_range(tube, 1.2, 8.7));
 
+  const auto bend = log_axis_ticks(1.45, 3.3);  // "2", "3" only from integer mantissas
+  ASSERT_EQ(bend.size(), 4u);
+  EXPECT_EQ(bend[0].label, "1.5");
+  EXPECT_EQ(bend[3].label, "3");
+
   const auto narrow = log_axis_ticks(2.1, 2.9);  // between two integer mantissas
   ASSERT_GE(narrow.size(), 2u);
   EXPECT_TRUE(in_range(narrow, 2.1, 2.9));

@@ -514,13 +514,14 @@ std::vector<Tick> log_axis_ticks(double lo, double hi) {
   auto one_two_five = pick({1, 2, 5});
   if (one_two_five.size() >= 3) return one_two_five;
   auto all = pick({1, 2, 3, 4, 5, 6, 7, 8, 9});
-  if (all.size() >= 2) return all;
-  // Narrower than the gap between two integer mantissas: linear 1-2-5 steps.
+  if (all.size() >= 3) return all;
+  // Within a few integer mantissas (1.5-3.3 s has only "2" and "3"): linear
+  // 1-2-5 steps, when they give more labels.
   const double step = nice_step((hi - lo) / 4.0);
   std::vector<Tick> t;
   for (double i = std::ceil(lo / step * (1 - tol)); i * step <= hi * (1 + tol); i += 1.0)
     t.push_back({i * step, tick_text(i * step)});
-  return t;
+  return t.size() > all.size() ? t : all;
 }
 
 TitleLayout fit_title(const std::string& title, double width_chars) {

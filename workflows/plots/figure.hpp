@@ -74,9 +74,9 @@ struct Tick {
 /// 0 < lo < hi). PLplot's own log axes number whole decades only, so an axis
 /// inside one decade (wall times of 2-6 s) would carry no numbers at all.
 /// This picks the sparsest of 1x10^k, {1,2,5}x10^k, {1..9}x10^k that gives at
-/// least two ticks in range (thinning whole decades when there are too many);
-/// if even {1..9}x10^k gives fewer than two, it falls back to evenly spaced
-/// 1-2-5 steps inside the range. Labels are plain decimals ("0.02", "5000")
+/// least three ticks in range (thinning whole decades when there are too
+/// many); when even {1..9}x10^k gives fewer than three, evenly spaced 1-2-5
+/// steps inside the range if they give more. Labels are plain decimals ("0.02", "5000")
 /// within 1e-3..1e4, otherwise mantissa x 10^k in PLplot's superscript syntax.
 std::vector<Tick> log_axis_ticks(double lo, double hi);
 
