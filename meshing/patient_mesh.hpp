@@ -26,7 +26,7 @@ struct PatientMeshOptions {
   // diameter (0.22 / 2.8 and 0.38 / 2.8); 0 omits the layer. The rest is intima.
   double media_ratio = 0.0786, adventitia_ratio = 0.136;
   bool intima = true;             // false: media reaches the lumen (paper Case 1 style)
-  double min_intima = 0.1;        // mm; thinner walls shrink media and adventitia to keep it
+  double min_intima = 0.05;       // mm (DESIGN.md §8); thinner walls shrink media and adventitia to keep it
   double station_spacing = 0.5;   // mm between lofted cross-sections
   int points_per_section = 32;    // rays per cross-section
   double end_trim = 0.2;          // mm cut off each centerline end
@@ -36,8 +36,9 @@ struct PatientMeshOptions {
   /// side of a bend of radius R; 0.1 allows r up to 0.9 R).
   double min_section_gap_ratio = 0.1;
   /// Corner scaled Jacobian bound (1: regular tet, 0: flat). 0.05: gmsh's
-  /// meshes of the thin (0.1 mm) intima keep a few elements between 0.05 and
-  /// 0.1 (case2-rca at 0.25 mm: min 0.092); valid, positive-Jacobian elements.
+  /// meshes of the thin (0.05 mm) intima and of the media keep a few near-flat
+  /// elements (phantoms at 0.25 mm: min 0.052 tortuous, 0.100-0.138 the
+  /// others); valid, positive-Jacobian elements.
   double min_scaled_jacobian = 0.05;
   double max_aspect_ratio = 50.0;
   /// gmsh 3D algorithm: "delaunay" (reproducible: the same input gives the

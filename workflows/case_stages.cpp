@@ -47,7 +47,7 @@ Stage patient_mesh_stage(const CaseConfig& c) {
   s.inputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp", "centerline/centerline.vtp"};
   s.outputs = {"mesh/artery.vtu", "mesh/artery.msh"};
   s.config = slice(c, {"mesh"});
-  s.version = "3";  // 3: gmsh Delaunay (reproducible), symmetric section tangents, pre-loft section checks; 2: per-layer sizing, tet10 midside-node Jacobian check
+  s.version = "4";  // 4: min_intima 0.05 mm (DESIGN.md §8), loft seams of neighbouring surfaces half a turn apart, 3 surface smoothing passes; 3: gmsh Delaunay (reproducible), symmetric section tangents, pre-loft section checks; 2: per-layer sizing, tet10 midside-node Jacobian check
   const meshing::PatientMeshOptions o = c.mesh;
   s.run = [o](StageContext& ctx) {
     meshing::run_patient_mesh(ctx.input("segmentation/lumen.vtp"), ctx.input("segmentation/wall.vtp"),
