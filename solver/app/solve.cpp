@@ -563,8 +563,8 @@ int solve_scene(const std::filesystem::path& scene_yaml, const SolveOptions& opt
   if (!writes) log::set_level(log::Level::warn);
   log::info("linear solver: {}; {} MPI rank(s)", linear->describe(), model.ranks);
   if (scene.linear.type == "direct" && model.ranks > 1)
-    log::info("direct solver on {} ranks: the assembled matrix is gathered on rank 0 and factored there with Eigen "
-              "SparseLU (serial; memory and time of one rank); use gmres_ilu or gmres_amg for large models", model.ranks);
+    log::info("direct solver on {} ranks: the assembled matrix is gathered on rank 0 and factored there with "
+              "UMFPACK (serial; memory and time of one rank); use gmres_ilu or gmres_amg for large models", model.ranks);
 
   ResultsWriter writer(writes ? out_dir : std::filesystem::temp_directory_path() /
                                               fmt::format("stentsim_rank{}_{}", model.rank, ::getpid()));

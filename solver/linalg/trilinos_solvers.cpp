@@ -216,21 +216,23 @@ class TrilinosSolver : public LinearSolver {
     std::string failure;
     x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
     if (root) {
-      CsrMatrix a;
-      a.rows = n;
-      a.row_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
-      Teuchos::Array<GO> cols(gathered->getGlobalMaxNumRowEntries());
-      Teuchos::Array<SC> vals(gathered->getGlobalMaxNumRowEntries());
-      for (GO i = 0; i < n; ++i) {
-        std::size_t count = 0;
-        gathered->getGlobalRowCopy(i, cols(), vals(), count);
-        std::vector<std::pair<GO, SC>> row;
-        for (std::size_t k = 0; k < count; ++k) row.emplace_back(cols[k], vals[k]);
-        std::sort(row.begin(), row.end());
-        for (const auto& [c, v] : row) a.cols.push_back(c), a.values.push_back(v);
-        a.row_ptr[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(a.cols.size());
-      }
+      // Everything on rank 0 inside the try: an exception there must reach the
+      // other ranks, which would otherwise wait in the broadcast below.
       try {
+        CsrMatrix a;
+        a.rows = n;
+        a.row_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
+        Teuchos::Array<GO> cols(gathered->getGlobalMaxNumRowEntries());
+        Teuchos::Array<SC> vals(gathered->getGlobalMaxNumRowEntries());
+        for (GO i = 0; i < n; ++i) {
+          std::size_t count = 0;
+          gathered->getGlobalRowCopy(i, cols(), vals(), count);
+          std::vector<std::pair<GO, SC>> row;
+          for (std::size_t k = 0; k < count; ++k) row.emplace_back(cols[k], vals[k]);
+          std::sort(row.begin(), row.end());
+          for (const auto& [c, v] : row) a.cols.push_back(c), a.values.push_back(v);
+          a.row_ptr[static_cast<std::size_t>(i) + 1] = static_cast<std::int64_t>(a.cols.size());
+        }
         stats = direct_->solve(a, b, x);
       } catch (const std::exception& e) {
         failure = e.what();  // thrown on every rank below: the others would wait in the broadcast

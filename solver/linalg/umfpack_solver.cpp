@@ -79,7 +79,9 @@ class UmfpackSolver : public LinearSolver {
     LinearSolveStats s;
     s.iterations = 1;
     s.relative_residual = (a.multiply(x) - b).norm() / std::max(b.norm(), 1e-300);
-    s.converged = x.allFinite();
+    // A nearly singular matrix factors without UMFPACK's singular warning but
+    // gives a useless solution: not "converged" then (Newton logs it).
+    s.converged = x.allFinite() && s.relative_residual <= 1e-6;
     s.setup_seconds = std::chrono::duration<double>(t1 - t0).count();
     s.solve_seconds = std::chrono::duration<double>(t2 - t1).count();
     return s;

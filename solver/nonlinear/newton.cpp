@@ -119,7 +119,9 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
                ls.amg_levels > 0 ? fmt::format(" (AMG levels {})", ls.amg_levels) : std::string());
     // Round-off floor: an increment at machine precision cannot improve the state
     // further (tiny loads on stiff models leave |R| just above an absolute tolerance).
-    const bool stagnated = du_norm <= 1e-13 * std::max(u.norm(), 1e-300) && it > 1;
+    // Only after a linear solve that converged: a failed Krylov solve can return
+    // a near-zero increment from a state far from equilibrium.
+    const bool stagnated = du_norm <= 1e-13 * std::max(u.norm(), 1e-300) && it > 1 && ls.converged;
     if ((r_ok && du_ok) || stagnated) {
       res.converged = true;
       return res;
