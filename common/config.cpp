@@ -12,18 +12,6 @@
 namespace stentsim {
 namespace {
 
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    cur[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j)
-      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-    std::swap(prev, cur);
-  }
-  return prev[b.size()];
-}
-
 std::string fmt_number(double v) { return fmt::format("{:g}", v); }
 
 /// yaml-cpp keeps the first of two equal map keys and drops the second
@@ -304,6 +292,25 @@ std::string canonical_yaml(const YAML::Node& node) {
   std::ostringstream out;
   emit_canonical(node, out);
   return out.str();
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+std::string closest_name(const std::vector<std::string>& candidates, const std::string& given) {
+  std::string closest;
+  for (const auto& c : candidates)
+    if (closest.empty() || edit_distance(c, given) < edit_distance(closest, given)) closest = c;
+  return !closest.empty() && edit_distance(closest, given) <= std::max<std::size_t>(2, given.size() / 3) ? closest : std::string();
 }
 
 }  // namespace stentsim

@@ -86,4 +86,10 @@ class ConfigMap {
 /// configuration slice so that key order does not make a stage stale.
 std::string canonical_yaml(const YAML::Node& node);
 
+/// Levenshtein distance, for "did you mean" hints.
+std::size_t edit_distance(const std::string& a, const std::string& b);
+/// The candidate nearest to `given` when it is near enough to be a likely
+/// misspelling (distance <= max(2, |given| / 3)); empty otherwise.
+std::string closest_name(const std::vector<std::string>& candidates, const std::string& given);
+
 }  // namespace stentsim

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <optional>
 
+#include "common/config.hpp"
 #include "common/error.hpp"
 #include "pipeline/runner.hpp"
 #include "workflows/case_config.hpp"
@@ -49,14 +50,11 @@ void check_stage_names(const workflows::CohortConfig& c, const std::vector<std::
     const auto& k = c.cases[i];
     for (const auto& [option, stage] : given) {
       if (std::find(k.stages.begin(), k.stages.end(), stage) != k.stages.end()) continue;
-      std::string closest, list;
-      for (const auto& s : k.stages) {
-        list += (list.empty() ? "" : ", ") + s;
-        if (closest.empty() || study::edit_distance(s, stage) < study::edit_distance(closest, stage)) closest = s;
-      }
-      const bool near = !closest.empty() && study::edit_distance(closest, stage) <= std::max<std::size_t>(2, stage.size() / 3);
+      std::string list;
+      for (const auto& s : k.stages) list += (list.empty() ? "" : ", ") + s;
+      const std::string closest = closest_name(k.stages, stage);
       throw InputError(fmt::format("{}: {} '{}' is not a stage of case '{}' (its stages: {}){}", c.file.string(), option, stage,
-                                   k.id, list, near ? fmt::format("; did you mean '{}'?", closest) : std::string()));
+                                   k.id, list, closest.empty() ? std::string() : fmt::format("; did you mean '{}'?", closest)));
     }
   }
 }

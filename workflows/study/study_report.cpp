@@ -1,5 +1,7 @@
 #include "workflows/study/study_report.hpp"
 
+#include "common/config.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -55,18 +57,6 @@ std::string join(const std::vector<double>& v) {
 
 }  // namespace
 
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    cur[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j)
-      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-    std::swap(prev, cur);
-  }
-  return prev[b.size()];
-}
-
 int fail_runs_missing_qoi(const StudyConfig& s, const StudyPlan& plan, std::vector<RunResult>& results) {
   int marked = 0;
   for (std::size_t i = 0; i < results.size() && i < plan.runs.size(); ++i) {
@@ -77,9 +67,8 @@ int fail_runs_missing_qoi(const StudyConfig& s, const StudyPlan& plan, std::vect
       if (name != kPerRankMemoryQoi) names.push_back(name);
     std::stable_sort(names.begin(), names.end(),
                      [&](const std::string& a, const std::string& b) { return edit_distance(a, s.qoi) < edit_distance(b, s.qoi); });
-    std::string hint;
-    if (!names.empty() && edit_distance(names.front(), s.qoi) <= std::max<std::size_t>(2, s.qoi.size() / 3))
-      hint = fmt::format(" (did you mean '{}'?)", names.front());
+    const std::string closest = closest_name(names, s.qoi);
+    const std::string hint = closest.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", closest);
     std::string present;
     for (const auto& n : names) present += (present.empty() ? "" : ", ") + n;
     r.status = "failed";

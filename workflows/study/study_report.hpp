@@ -48,9 +48,6 @@ struct StudyOutcome {
 /// would exit 0 with an empty report.
 int fail_runs_missing_qoi(const StudyConfig& study, const StudyPlan& plan, std::vector<RunResult>& results);
 
-/// Levenshtein distance, for "did you mean".
-std::size_t edit_distance(const std::string& a, const std::string& b);
-
 /// Errors, orders, front. Throws InputError for a study whose reference does
 /// not fit its QoI (component count). A relative error against a reference
 /// that vanishes (kVanishingQoi) is reported as absolute, with error_note.
