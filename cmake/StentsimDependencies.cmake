@@ -8,6 +8,21 @@ macro(stentsim_require found pkg what)
   endif()
 endmacro()
 
+# A library that ships no CMake config: header + library found by name, and an
+# INTERFACE target `target` carrying both. Extra arguments go to find_path
+# (e.g. PATH_SUFFIXES suitesparse).
+function(stentsim_plain_library target header lib pkg what)
+  string(MAKE_C_IDENTIFIER "${target}" id)
+  find_path(${id}_INCLUDE_DIR ${header} ${ARGN})
+  find_library(${id}_LIBRARY ${lib})
+  if(NOT ${id}_INCLUDE_DIR OR NOT ${id}_LIBRARY)
+    stentsim_require(FALSE "${pkg}" "${what}")
+  endif()
+  add_library(${target} INTERFACE)
+  target_include_directories(${target} INTERFACE ${${id}_INCLUDE_DIR})
+  target_link_libraries(${target} INTERFACE ${${id}_LIBRARY})
+endfunction()
+
 find_package(MPI QUIET COMPONENTS C CXX)
 stentsim_require(MPI_CXX_FOUND "libopenmpi-dev openmpi-bin" "MPI (C++)")
 
@@ -26,14 +41,7 @@ stentsim_require(CLI11_FOUND libcli11-dev "CLI11")
 find_package(Threads REQUIRED)
 
 # xxHash ships no CMake config in Debian 12.
-find_path(XXHASH_INCLUDE_DIR xxhash.h)
-find_library(XXHASH_LIBRARY xxhash)
-if(NOT XXHASH_INCLUDE_DIR OR NOT XXHASH_LIBRARY)
-  stentsim_require(FALSE libxxhash-dev "xxHash")
-endif()
-add_library(stentsim_xxhash INTERFACE)
-target_include_directories(stentsim_xxhash INTERFACE ${XXHASH_INCLUDE_DIR})
-target_link_libraries(stentsim_xxhash INTERFACE ${XXHASH_LIBRARY})
+stentsim_plain_library(stentsim_xxhash xxhash.h xxhash libxxhash-dev "xxHash")
 
 # VTK: name the components, otherwise Debian's config also wants Qt5 dev packages.
 find_package(VTK 9.1 QUIET COMPONENTS
@@ -49,26 +57,12 @@ find_package(CGAL QUIET)
 stentsim_require(CGAL_FOUND libcgal-dev "CGAL")
 
 # gmsh ships no CMake config: header + library.
-find_path(GMSH_INCLUDE_DIR gmsh.h)
-find_library(GMSH_LIBRARY gmsh)
-if(NOT GMSH_INCLUDE_DIR OR NOT GMSH_LIBRARY)
-  stentsim_require(FALSE libgmsh-dev "gmsh C++ API")
-endif()
-add_library(stentsim_gmsh INTERFACE)
-target_include_directories(stentsim_gmsh INTERFACE ${GMSH_INCLUDE_DIR})
-target_link_libraries(stentsim_gmsh INTERFACE ${GMSH_LIBRARY})
+stentsim_plain_library(stentsim_gmsh gmsh.h gmsh libgmsh-dev "gmsh C++ API")
 
 # UMFPACK (SuiteSparse) for the sparse direct solver: its AMD ordering of the
 # symmetric pattern keeps the fill of 3D finite-element matrices far below
 # KLU2's (Case 1 artery, 27k DOFs: 60 s per KLU2 factorization).
-find_path(UMFPACK_INCLUDE_DIR umfpack.h PATH_SUFFIXES suitesparse)
-find_library(UMFPACK_LIBRARY umfpack)
-if(NOT UMFPACK_INCLUDE_DIR OR NOT UMFPACK_LIBRARY)
-  stentsim_require(FALSE libsuitesparse-dev "UMFPACK (SuiteSparse)")
-endif()
-add_library(stentsim_umfpack INTERFACE)
-target_include_directories(stentsim_umfpack INTERFACE ${UMFPACK_INCLUDE_DIR})
-target_link_libraries(stentsim_umfpack INTERFACE ${UMFPACK_LIBRARY})
+stentsim_plain_library(stentsim_umfpack umfpack.h umfpack libsuitesparse-dev "UMFPACK (SuiteSparse)" PATH_SUFFIXES suitesparse)
 
 # PLplot (C API) for headless PNG/SVG figures; the cairo devices come from
 # plplot-driver-cairo (checked at run time, the driver is a plugin).
