@@ -173,8 +173,11 @@ double ConfigMap::quantity(const std::string& key, const units::Dimension& dim, 
 
 std::string ConfigMap::choice(const std::string& key, const std::vector<std::string>& options, std::optional<std::string> def) {
   std::string v = string(key, def);
-  if (std::find(options.begin(), options.end(), v) == options.end())
-    fail(key, fmt::format("'{}' is not one of: {}", v, fmt::join(options, ", ")));
+  if (std::find(options.begin(), options.end(), v) == options.end()) {
+    const std::string near = closest_name(options, v);
+    fail(key, fmt::format("'{}' is not one of: {}{}", v, fmt::join(options, ", "),
+                          near.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", near)));
+  }
   return v;
 }
 

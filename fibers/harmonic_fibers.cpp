@@ -281,7 +281,7 @@ struct Field {
 /// zero-flux condition imposed at the nodes of `zero_flux` (face normals by
 /// mesh node); tet10 and hex8 cells use their own centroid gradient.
 Field solve_field(const MeshData& mesh, const CornerMesh* corners, const std::map<std::int64_t, double>& d,
-                  const std::string& solver, const std::map<std::int64_t, Vec3>& zero_flux) {
+                  solver::LinearSolverType solver, const std::map<std::int64_t, Vec3>& zero_flux) {
   Field f;
   if (!corners) {
     f.solve = solve_laplace(mesh, d, solver);
@@ -510,7 +510,7 @@ void write_harmonic_fibers(const std::string& artery_vtu, const std::string& cen
   summary.set("tangent_vs_grad_l_angle_max", q.tangent_blend_angle_max_deg, "deg");
   summary.set("laplace_relative_residual", std::max(r.transmural_residual, r.longitudinal_residual));
   summary.set("laplace_time", r.laplace_seconds, "s");
-  summary.note("fiber_method", fmt::format("{}, linear solver {}", r.fibers.field_text.at("method"), o.linear_solver));
+  summary.note("fiber_method", fmt::format("{}, linear solver {}", r.fibers.field_text.at("method"), solver::linear_solver_name(o.linear_solver)));
   summary.set("laplace_transmural_unknowns", static_cast<double>(r.transmural_unknowns));
   summary.set("laplace_longitudinal_unknowns", static_cast<double>(r.longitudinal_unknowns));
   summary.set("laplace_transmural_iterations", r.transmural_iterations);

@@ -14,6 +14,7 @@
 #include "common/mesh_data.hpp"
 #include "common/summary.hpp"
 #include "fibers/analytic_tube_fibers.hpp"
+#include "solver/linalg/linear_solver.hpp"
 
 namespace stentsim::fibers {
 
@@ -26,7 +27,7 @@ struct HarmonicFiberOptions {
   /// On the quadratic transmural problem of the case2-rca tet10 wall (183,189
   /// nodes) ILU(1) set-up dominates: gmres_ilu 70 s CPU for both quadratic
   /// problems against 23 s with gmres_amg (bench_fibers).
-  std::string linear_solver = "gmres_amg";
+  solver::LinearSolverType linear_solver = solver::LinearSolverType::gmres_amg;
   /// tet10 meshes: solve the longitudinal Laplace problem with linear
   /// elements on the tet10 corner nodes (the tet4 mesh of the same vertices;
   /// about 7x fewer unknowns) and interpolate linearly to the midside nodes;

@@ -76,7 +76,7 @@ bool is_volume_cell(CellType t) {
 }
 
 LaplaceSolve solve_laplace(const MeshData& mesh, const std::map<std::int64_t, double>& dirichlet,
-                           const std::string& solver_type) {
+                           solver::LinearSolverType solver_type) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto n = static_cast<solver::GlobalDof>(mesh.points.size());
   // Points no volume cell touches (none in a clean mesh) get an identity row.

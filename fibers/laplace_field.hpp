@@ -11,6 +11,7 @@
 #include <string>
 
 #include "common/mesh_data.hpp"
+#include "solver/linalg/linear_solver.hpp"
 
 namespace stentsim::fibers {
 
@@ -28,7 +29,7 @@ struct LaplaceSolve {
 /// meshes; "gmres_ilu", "direct", "eigen_lu"). Throws ComputeError when the linear
 /// solver fails.
 LaplaceSolve solve_laplace(const MeshData& mesh, const std::map<std::int64_t, double>& dirichlet,
-                           const std::string& solver);
+                           solver::LinearSolverType solver);
 
 /// Gradient of the nodal field `u` at the reference centroid of volume cell `c`.
 Eigen::Vector3d centroid_gradient(const MeshData& mesh, std::size_t c, const Eigen::VectorXd& u);

@@ -7,6 +7,7 @@
 
 #include "common/config.hpp"
 #include "common/error.hpp"
+#include "solver/linalg/linear_solver_config.hpp"
 #include "workflows/case_sections.hpp"
 
 namespace stentsim::workflows {
@@ -78,7 +79,7 @@ FiberSettings parse_fibers(ConfigMap m) {
   s.adventitia_angle = m.quantity("adventitia_angle", units::kAngle, s.adventitia_angle, angle);
   s.tension_only = m.boolean("tension_only", s.tension_only);
   s.centerline_weight = m.number("centerline_weight", s.centerline_weight, Range::between(0, 1));
-  s.linear_solver = m.choice("linear_solver", {"gmres_ilu", "gmres_amg", "direct"}, s.linear_solver);
+  s.linear_solver = solver::read_linear_solver(m, "linear_solver", s.linear_solver);
   s.laplace_on_corners = m.boolean("laplace_on_corners", s.laplace_on_corners);
   m.finish();
   return s;
@@ -90,7 +91,7 @@ SimulationSettings parse_simulation(ConfigMap m) {
   s.diastolic_pressure = m.quantity("diastolic_pressure", units::kPressure, s.diastolic_pressure, Range::between(0, 0.1));
   s.phase_duration = m.quantity("phase_duration", units::kTime, s.phase_duration, Range::positive());
   s.load_steps = m.integer("load_steps", s.load_steps, Range::between(1, 100000));
-  s.linear_solver = m.choice("linear_solver", {"direct", "gmres-ilu", "gmres-amg"}, s.linear_solver);
+  s.linear_solver = solver::read_linear_solver(m, "linear_solver", s.linear_solver);
   s.ranks = m.integer("ranks", s.ranks, Range::between(1, 4096));
   s.balloon_end_springs = m.quantity("balloon_end_springs", units::kStiffnessPerArea, s.balloon_end_springs, Range::positive());
   s.cut_springs = m.quantity("cut_springs", units::kStiffnessPerArea, s.cut_springs, Range::positive());

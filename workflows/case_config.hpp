@@ -10,6 +10,7 @@
 
 #include "meshing/generic_artery.hpp"
 #include "meshing/patient_mesh.hpp"
+#include "solver/linalg/linear_solver.hpp"
 
 
 
@@ -29,7 +30,7 @@ struct FiberSettings {
   double media_angle = 0.0, intima_angle = 0.0, adventitia_angle = 0.6981317007977318;  // rad (40 deg)
   bool tension_only = false;
   double centerline_weight = 0.5;          // patient: centerline tangent vs grad l (fibers/harmonic_fibers.hpp)
-  std::string linear_solver = "gmres_amg"; // patient Laplace solves: gmres_amg | gmres_ilu | direct
+  solver::LinearSolverType linear_solver = solver::LinearSolverType::gmres_amg;  // the Laplace solves (patient scene)
   bool laplace_on_corners = true;          // tet10: longitudinal problem on the corner nodes (t stays quadratic)
 };
 
@@ -38,7 +39,7 @@ struct SimulationSettings {
   double diastolic_pressure = 85 * 133.322387415e-6;  // MPa
   double phase_duration = 1.0;             // s of pseudo-time per phase
   int load_steps = 100;                    // per phase, initial
-  std::string linear_solver = "gmres-ilu"; // direct | gmres-ilu | gmres-amg
+  solver::LinearSolverType linear_solver = solver::LinearSolverType::direct;
   int ranks = 1;
   double balloon_end_springs = 100.0;      // N/mm^3
   double cut_springs = 1000.0;             // N/mm^3

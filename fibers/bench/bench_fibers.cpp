@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
     o.transmural_on_corners = mode == "corners";
     std::printf("mode %s\n", mode.c_str());
     const char* solver = name.c_str();
-    o.linear_solver = solver;
+    o.linear_solver = solver::parse_linear_solver(solver, "bench_fibers: solver list");
     std::vector<double> total, laplace, cpu;
     for (int r = 0; r < runs; ++r) {
       const auto t0 = std::chrono::steady_clock::now();

@@ -26,6 +26,18 @@ void Model::assemble(const Eigen::VectorXd& u, double time, double dt, const Eig
   system.finish();
 }
 
+void Model::begin_step(const Eigen::VectorXd& u, double time, double dt) {
+  const SystemState state{u, time, dt, rank, ranks};
+  std::string failure;
+  try {
+    for (auto& t : terms) t->begin_step(state);
+  } catch (const ElementFailure& e) {
+    failure = e.what();
+  }
+  if (ranks > 1) failure = parallel::first_message(!failure.empty(), failure);
+  if (!failure.empty()) throw ElementFailure(failure);
+}
+
 Eigen::MatrixXd Model::rigid_body_modes(const std::vector<std::pair<GlobalDof, Vec3>>& nodes) const {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(dofs.size(), 6);
   for (const auto& [first, x] : nodes) {

@@ -32,6 +32,9 @@ class Model {
   void assemble(const Eigen::VectorXd& u, double time, double dt, const Eigen::VectorXd& prescribed,
                 GlobalSystem& system, bool with_tangent = true);
 
+  /// Every term's begin_step at (u, time, dt): before each attempt of a load step. A term that
+  /// cannot prepare the step (ElementFailure) on one rank fails it on every rank.
+  void begin_step(const Eigen::VectorXd& u, double time, double dt);
   void trial(const Eigen::VectorXd& du) { for (auto& t : terms) t->trial(du); }
   void accept() { for (auto& t : terms) t->accept(); }
   void commit() { for (auto& t : terms) t->commit(); }

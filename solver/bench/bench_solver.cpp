@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
     model.add_term<RobinSprings>("cuts", body, cuts, 1000.0);
     model.size_constraints();
     LinearSolverSettings ls;
-    ls.type = type;
+    ls.type = parse_linear_solver(type, "bench_solver: first argument");
     ls.tolerance = 1e-8;
     auto linear = make_linear_solver(ls);
     model.rank = parallel::rank();

@@ -9,6 +9,8 @@
 
 #include "common/error.hpp"
 #include "solver/io/generated_meshes.hpp"
+#include "solver/io/scene_kinds.hpp"
+#include "solver/linalg/linear_solver_config.hpp"
 #include "solver/materials/presets.hpp"
 
 namespace stentsim::solver {
@@ -111,13 +113,65 @@ Material read_material(ConfigMap& m) {
 
 }  // namespace
 
+const BodyDesc* SceneDesc::body(const std::string& name) const {
+  for (const auto& b : bodies)
+    if (b.name == name) return &b;
+  return nullptr;
+}
+
+const BodyDesc& SceneReader::body(ConfigMap& c, const std::string& key, std::optional<bool> beam, const std::string& type) const {
+  const std::string name = c.string(key);
+  const BodyDesc* b = scene.body(name);
+  if (!b) {
+    std::vector<std::string> names;
+    for (const auto& x : scene.bodies) names.push_back(x.name);
+    const std::string near = closest_name(names, name);
+    c.fail(key, fmt::format("no body named '{}'{}", name, near.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", near)));
+  }
+  if (beam && b->beam.has_value() != *beam)
+    c.fail(key, fmt::format("'{}' applies to {} bodies; '{}' is a {} body", type, *beam ? "beam" : "solid", name,
+                            b->beam ? "beam" : "solid"));
+  return *b;
+}
+
+std::string SceneReader::curve(ConfigMap& c, const std::string& key, bool required) const {
+  const std::string name = required ? c.string(key) : c.string(key, "");
+  if (!name.empty() && !scene.curves.count(name)) c.fail(key, fmt::format("no load curve named '{}' in load_curves", name));
+  return name;
+}
+
+beams::BeamNodeSelector SceneReader::beam_nodes(ConfigMap& c, const std::string& key, const BodyDesc& body) const {
+  const beams::BeamNodeSelector sel = beams::read_beam_node_selector(c, key);
+  std::vector<int> nodes;
+  try {
+    nodes = beams::select_beam_nodes(*body.beam, sel);
+  } catch (const InputError& e) {
+    c.fail(key, e.what());
+  }
+  if (nodes.empty()) c.fail(key, fmt::format("selects no end node of beam body '{}' ({})", body.name, sel.describe()));
+  return sel;
+}
+
+Vec3 SceneReader::vec3(ConfigMap& m, const std::string& key, std::optional<Vec3> def) { return solver::vec3(m, key, def); }
+
+void SceneReader::axis(ConfigMap& c, const std::string& key, Vec3& origin, Vec3& direction) {
+  origin = Vec3::Zero(), direction = Vec3::UnitZ();
+  if (auto ax = c.optional_map(key)) {
+    origin = solver::vec3(*ax, "origin", Vec3::Zero());
+    direction = solver::vec3(*ax, "direction", Vec3::UnitZ());
+    if (!(direction.norm() > 0)) ax->fail("direction", "must be a non-zero vector");
+    direction.normalize();
+    ax->finish();
+  }
+}
+
 SceneDesc read_scene(const std::filesystem::path& file) {
   ConfigMap root = ConfigMap::load(file);
   SceneDesc scene;
   scene.file = file;
   scene.description = root.string("description", "");
 
-  std::set<std::string> names, beam_names;
+  std::set<std::string> names;
   for (auto& b : root.map_list("bodies")) {
     BodyDesc body;
     body.name = b.string("name");
@@ -129,7 +183,6 @@ SceneDesc read_scene(const std::filesystem::path& file) {
       beam.finish();
       body.mesh_source = body.beam->source;
       b.finish();
-      beam_names.insert(body.name);
       scene.bodies.push_back(std::move(body));
       continue;
     }
@@ -200,189 +253,29 @@ SceneDesc read_scene(const std::filesystem::path& file) {
       }
     }
   }
-  auto check_curve = [&](ConfigMap& c, const std::string& name) {
-    if (!name.empty() && !scene.curves.count(name))
-      c.fail("curve", fmt::format("no load curve named '{}' in load_curves", name));
+  SceneReader reader(scene);
+  auto names_of = [](const auto& kinds) {
+    std::vector<std::string> n;
+    for (const auto& k : kinds) n.push_back(k.type);
+    return n;
   };
-  auto check_body = [&](ConfigMap& c, const std::string& name) {
-    if (!names.count(name)) c.fail("body", fmt::format("no body named '{}'", name));
+  // One entry of a kind family: type, then name (unique; default <type>_<index>), then the kind's keys.
+  auto read_entry = [&](ConfigMap& c, const auto& kinds, const auto& existing, int index, bool name_required) {
+    const std::string type = c.choice("type", names_of(kinds));
+    const std::string name = name_required ? c.string("name") : c.string("name", fmt::format("{}_{}", type, index));
+    for (const auto& other : existing)
+      if (other->name == name) c.fail("name", fmt::format("the name '{}' is used twice", name));
+    for (const auto& k : kinds)
+      if (k.type == type) {
+        auto spec = k.read(c, reader);
+        spec->name = name;
+        c.finish();
+        return spec;
+      }
+    throw std::logic_error("scene kind lookup");
   };
-  // Solid conditions/QoIs need a solid body, beam ones a beam body.
-  auto check_kind = [&](ConfigMap& c, const std::string& name, bool beam, const std::string& type) {
-    if (beam_names.count(name) != static_cast<std::size_t>(beam))
-      c.fail("body", fmt::format("'{}' applies to {} bodies; '{}' is a {} body", type, beam ? "beam" : "solid", name,
-                                 beam_names.count(name) ? "beam" : "solid"));
-  };
-  auto beam_body = [&](const std::string& name) -> const beams::BeamBodyDesc& {
-    for (const auto& b : scene.bodies)
-      if (b.name == name) return *b.beam;
-    throw std::logic_error("beam body lookup");
-  };
-  // A beam node selection must select something (file:line of the key).
-  auto check_nodes = [&](ConfigMap& c, const std::string& body, const beams::BeamNodeSelector& sel) {
-    std::vector<int> nodes;
-    try {
-      nodes = beams::select_beam_nodes(beam_body(body), sel);
-    } catch (const InputError& e) {
-      c.fail("node", e.what());
-    }
-    if (nodes.empty()) c.fail("node", fmt::format("selects no end node of beam body '{}' ({})", body, sel.describe()));
-  };
-  // Cylindrical beam conditions: `axis: {origin, direction}` (default the z axis).
-  auto read_axis = [&](ConfigMap& c, ConditionDesc& d) {
-    if (auto ax = c.optional_map("axis")) {
-      d.axis_origin = vec3(*ax, "origin", Vec3::Zero());
-      d.axis = vec3(*ax, "direction", Vec3::UnitZ());
-      if (!(d.axis.norm() > 0)) ax->fail("direction", "must be a non-zero vector");
-      d.axis.normalize();
-      ax->finish();
-    }
-  };
-  std::map<std::string, std::string> radial_conditions;  // radial_displacement name -> body (for release)
-  std::set<std::string> released;
-
   int index = 0;
-  for (auto& c : root.map_list("conditions")) {
-    ConditionDesc d;
-    const std::string type =
-        c.choice("type", {"pressure", "springs", "dirichlet", "clamp", "point_force", "point_moment", "direction",
-                          "radial_displacement", "fix_cylindrical", "release"});
-    d.name = c.string("name", fmt::format("{}_{}", type, index++));
-    for (const auto& other : scene.conditions)
-      if (other.name == d.name) c.fail("name", fmt::format("condition name '{}' is used twice", d.name));
-    d.body = c.string("body");
-    check_body(c, d.body);
-    const bool beam_type = type == "clamp" || type == "point_force" || type == "point_moment" || type == "direction" ||
-                           type == "radial_displacement" || type == "fix_cylindrical" || type == "release";
-    check_kind(c, d.body, beam_type, type);
-    if (type == "release") {
-      // The radial conditions become point forces equal to their last reactions, × curve(t) after `at`.
-      d.type = ConditionDesc::Type::release;
-      d.release_from = c.string("from");
-      auto it = radial_conditions.find(d.release_from);
-      if (it == radial_conditions.end())
-        c.fail("from", fmt::format("no radial_displacement condition named '{}' before this one", d.release_from));
-      if (it->second != d.body) c.fail("from", fmt::format("'{}' holds body '{}', not '{}'", d.release_from, it->second, d.body));
-      if (!released.insert(d.release_from).second) c.fail("from", fmt::format("'{}' is released twice", d.release_from));
-      d.release_at = c.quantity("at", units::kTime);
-      d.curve = c.string("curve");
-      check_curve(c, d.curve);
-      const double f = scene.curves.at(d.curve)(d.release_at);
-      if (std::abs(f - 1.0) > 1e-12)
-        c.fail("curve", fmt::format("the release curve '{}' must be 1 at the release time {} (it is {}): the forces start "
-                                    "at the last reactions", d.curve, d.release_at, f));
-      c.finish();
-      scene.conditions.push_back(d);
-      continue;
-    }
-    if (beam_type) {
-      d.node = beams::read_beam_node_selector(c, "node");
-      check_nodes(c, d.body, d.node);
-      if (type == "clamp") {
-        d.type = ConditionDesc::Type::clamp;
-        // Hermite ends: position + rotation by default; the tangent carries the root shear strain.
-        std::vector<std::string> fix{"position", "rotation"};
-        if (c.has("fix")) {  // words: "position rotation tangent" (any of them)
-          const std::string text = c.string("fix");
-          fix.clear();
-          std::string w;
-          for (std::size_t i = 0; i <= text.size(); ++i) {
-            if (i == text.size() || text[i] == ' ' || text[i] == ',') {
-              if (w.empty()) continue;
-              if (w != "position" && w != "rotation" && w != "tangent")
-                c.fail("fix", fmt::format("'{}' is not one of position, rotation, tangent", w));
-              fix.push_back(w);
-              w.clear();
-            } else {
-              w += text[i];
-            }
-          }
-          if (fix.empty()) c.fail("fix", "expected some of: position rotation tangent");
-        }
-        d.clamp_position = std::find(fix.begin(), fix.end(), "position") != fix.end();
-        d.clamp_rotation = std::find(fix.begin(), fix.end(), "rotation") != fix.end();
-        d.clamp_tangent = std::find(fix.begin(), fix.end(), "tangent") != fix.end();
-        if (d.clamp_tangent && beam_body(d.body).body.interpolation != beams::BeamInterpolation::hermite3)
-          c.fail("fix", "only Hermite (hermite3) beams have tangent DOFs");
-      } else if (type == "direction") {
-        d.type = ConditionDesc::Type::direction;
-        if (c.has("direction") && c.node()["direction"].IsScalar()) {
-          if (c.choice("direction", {"file"}) == "file") d.direction_from_file = true;
-          if (d.node.kind != beams::BeamNodeSelector::Kind::fixations)
-            c.fail("direction", "'file' takes the stent file's fixation directions; it needs node: fixations");
-        } else {
-          d.vector = vec3(c, "direction");
-          if (!(d.vector.norm() > 0)) c.fail("direction", "must be a non-zero vector");
-          d.vector.normalize();
-        }
-      } else if (type == "radial_displacement") {
-        d.type = ConditionDesc::Type::radial_displacement;
-        read_axis(c, d);
-        d.value = c.quantity("value", units::kLength);
-        d.curve = c.string("curve", "");
-      } else if (type == "fix_cylindrical") {
-        d.type = ConditionDesc::Type::fix_cylindrical;
-        read_axis(c, d);
-        const std::string text = c.string("components");  // words: radial circumferential axial
-        std::string w;
-        for (std::size_t i = 0; i <= text.size(); ++i) {
-          if (i == text.size() || text[i] == ' ' || text[i] == ',') {
-            if (w.empty()) continue;
-            const int k = w == "radial" ? 0 : w == "circumferential" ? 1 : w == "axial" ? 2 : -1;
-            if (k < 0) c.fail("components", fmt::format("'{}' is not one of radial, circumferential, axial", w));
-            if (std::find(d.components.begin(), d.components.end(), k) == d.components.end()) d.components.push_back(k);
-            w.clear();
-          } else {
-            w += text[i];
-          }
-        }
-        if (d.components.empty()) c.fail("components", "expected some of: radial circumferential axial");
-      } else {
-        d.type = type == "point_force" ? ConditionDesc::Type::point_force : ConditionDesc::Type::point_moment;
-        d.vector = vec3(c, "value");  // N (force) or N mm (moment), dead (fixed in space)
-        d.curve = c.string("curve", "");
-      }
-      check_curve(c, d.curve);
-      c.finish();
-      scene.conditions.push_back(d);
-      if (d.type == ConditionDesc::Type::radial_displacement) radial_conditions[d.name] = d.body;
-      continue;
-    }
-    if (type == "pressure") {
-      d.type = ConditionDesc::Type::pressure;
-      d.where = read_selector(c, "surface");
-      d.value = c.quantity("value", units::kPressure);
-      d.curve = c.string("curve", "");
-    } else if (type == "springs") {
-      d.type = ConditionDesc::Type::springs;
-      d.where = read_selector(c, "surface");
-      d.value = c.quantity("stiffness", units::kStiffnessPerArea, std::nullopt, Range::positive());
-    } else {
-      d.type = ConditionDesc::Type::dirichlet;
-      d.where = read_selector(c, "nodes");
-      d.value = c.quantity("value", units::kLength, 0.0);
-      d.curve = c.string("curve", "");
-      if (auto r = c.optional_map("radial_only")) {
-        d.radial_only = true;
-        d.axis_origin = vec3(*r, "origin", Vec3::Zero());
-        d.axis = vec3(*r, "axis", Vec3::UnitZ()).normalized();
-        r->finish();
-        if (d.value != 0.0) c.fail("value", "radial_only fixes the non-radial components to zero; value must be 0");
-      } else {
-        // "x", "xy", "x z", "xyz": the fixed global components.
-        const std::string comps = c.string("components");
-        for (char ch : comps) {
-          if (ch == ' ' || ch == ',') continue;
-          if (ch < 'x' || ch > 'z') c.fail("components", fmt::format("'{}' is not a list of x, y, z (e.g. 'xz')", comps));
-          if (std::find(d.components.begin(), d.components.end(), ch - 'x') == d.components.end()) d.components.push_back(ch - 'x');
-        }
-        if (d.components.empty()) c.fail("components", "expected at least one of x, y, z (e.g. 'xyz')");
-      }
-    }
-    check_curve(c, d.curve);
-    c.finish();
-    scene.conditions.push_back(d);
-  }
+  for (auto& c : root.map_list("conditions")) scene.conditions.push_back(read_entry(c, condition_kinds(), scene.conditions, index++, false));
 
   ConfigMap s = root.map("solver");
   ConfigMap time = s.map("time");
@@ -402,14 +295,7 @@ SceneDesc read_scene(const std::filesystem::path& file) {
     scene.stepping.stops = time.numbers("stops", n.IsSequence() ? n.size() : 0);
   }
   time.finish();
-  // A release happens at the end of a converged step: its time is a stop inside the run.
-  for (const auto& c : scene.conditions) {
-    if (c.type != ConditionDesc::Type::release) continue;
-    if (!(c.release_at > scene.stepping.t_start && c.release_at < scene.stepping.t_end))
-      throw InputError(fmt::format("{}: condition '{}': release time at = {} must lie inside solver.time ({}, {})", file.string(),
-                                   c.name, c.release_at, scene.stepping.t_start, scene.stepping.t_end));
-    scene.stepping.stops.push_back(c.release_at);
-  }
+  for (const auto& c : scene.conditions) c->add_stops(scene, scene.stepping.stops);
   ConfigMap nw = s.map("newton");
   scene.newton.max_iterations = nw.integer("max_iterations", 20, Range::between(1, 1000));
   scene.newton.residual_tolerance = nw.number("residual_tolerance", 1e-8, Range::positive());
@@ -418,7 +304,7 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   scene.newton.line_search_steps = nw.integer("line_search_steps", 6, Range::between(0, 30));
   nw.finish();
   ConfigMap li = s.map("linear");
-  scene.linear.type = li.choice("type", {"direct", "gmres_ilu", "gmres_amg", "eigen_lu"}, "direct");
+  scene.linear.type = read_linear_solver(li, "type", LinearSolverType::direct);
   scene.linear.tolerance = li.number("tolerance", 1e-10, Range::positive());
   scene.linear.max_iterations = li.integer("max_iterations", 2000, Range::between(1, 1000000));
   scene.linear.krylov_size = li.integer("krylov_size", 200, Range::between(1, 10000));
@@ -435,59 +321,12 @@ SceneDesc read_scene(const std::filesystem::path& file) {
     out.fail("load_factor_curve", fmt::format("no load curve named '{}'", scene.load_factor_curve));
   out.finish();
 
-  for (auto& q : root.map_list("qoi")) {
-    QoiDesc d;
-    d.name = q.string("name");
-    const std::string type =
-        q.choice("type", {"mean_radius", "max_displacement", "tip_position", "tip_rotation_angle", "ring_expansion"});
-    d.type = type == "mean_radius"          ? QoiDesc::Type::mean_radius
-             : type == "max_displacement"   ? QoiDesc::Type::max_displacement
-             : type == "tip_position"       ? QoiDesc::Type::tip_position
-             : type == "ring_expansion"     ? QoiDesc::Type::ring_expansion
-                                            : QoiDesc::Type::tip_rotation_angle;
-    d.body = q.string("body");
-    check_body(q, d.body);
-    const bool beam_qoi = d.type == QoiDesc::Type::tip_position || d.type == QoiDesc::Type::tip_rotation_angle ||
-                          d.type == QoiDesc::Type::ring_expansion;
-    check_kind(q, d.body, beam_qoi, type);
-    if (d.type == QoiDesc::Type::ring_expansion) {
-      for (const auto& other : scene.qois)
-        if (other.type == QoiDesc::Type::ring_expansion) q.fail("type", "one ring_expansion QoI per scene (its summary keys have no prefix)");
-      d.node = beams::read_beam_node_selector(q, "node");
-      check_nodes(q, d.body, d.node);
-      if (auto ax = q.optional_map("axis")) {
-        d.axis_origin = vec3(*ax, "origin", Vec3::Zero());
-        d.axis = vec3(*ax, "direction", Vec3::UnitZ()).normalized();
-        ax->finish();
-      }
-      d.time = q.quantity("peak_time", units::kTime);  // D_max; D_end at the end
-      if (!(d.time > scene.stepping.t_start && d.time <= scene.stepping.t_end))
-        q.fail("peak_time", "must lie inside solver.time");
-      scene.stepping.stops.push_back(d.time);
-      q.finish();
-      scene.qois.push_back(d);
-      continue;
-    }
-    if (beam_qoi) {
-      d.node = beams::read_beam_node_selector(q, "node");
-      if (d.node.kind == beams::BeamNodeSelector::Kind::fixations) q.fail("node", "a tip QoI needs one node (first, last or a point)");
-      check_nodes(q, d.body, d.node);
-      if (beams::select_beam_nodes(beam_body(d.body), d.node).size() != 1) q.fail("node", "selects more than one node");
-    } else {
-      d.where = read_selector(q, "nodes");
-    }
-    if (d.type == QoiDesc::Type::mean_radius) {
-      ConfigMap ax = q.map("axis");
-      d.axis_origin = vec3(ax, "origin", Vec3::Zero());
-      d.axis = vec3(ax, "direction", Vec3::UnitZ()).normalized();
-      ax.finish();
-    }
-    d.time = q.quantity("time", units::kTime, scene.stepping.t_end);
-    // the QoI is taken at an output step: make its time a stop
-    scene.stepping.stops.push_back(d.time);
-    q.finish();
-    scene.qois.push_back(d);
-  }
+  // Contact pairs and QoIs after solver.time: their report times must lie inside it and become stops.
+  index = 0;
+  if (root.has("contact"))
+    for (auto& c : root.map_list("contact")) scene.contacts.push_back(read_entry(c, contact_kinds(), scene.contacts, index++, false));
+  index = 0;
+  for (auto& q : root.map_list("qoi")) scene.qois.push_back(read_entry(q, qoi_kinds(), scene.qois, index++, true));
   root.finish();
   return scene;
 }

@@ -43,11 +43,8 @@ class EigenLuSolver : public LinearSolver {
 std::unique_ptr<LinearSolver> make_eigen_lu_solver() { return std::make_unique<EigenLuSolver>(); }
 
 std::unique_ptr<LinearSolver> make_linear_solver(const LinearSolverSettings& settings) {
-  if (settings.type == "eigen_lu") return make_eigen_lu_solver();
-  if (settings.type == "direct" || settings.type == "gmres_ilu" || settings.type == "gmres_amg")
-    return make_trilinos_solver(settings);
-  throw std::invalid_argument("unknown linear solver '" + settings.type +
-                              "' (expected direct, gmres_ilu, gmres_amg or eigen_lu)");
+  if (settings.type == LinearSolverType::eigen_lu) return make_eigen_lu_solver();
+  return make_trilinos_solver(settings);
 }
 
 }  // namespace stentsim::solver

@@ -8,15 +8,26 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "solver/linalg/csr_matrix.hpp"
 
 namespace stentsim::solver {
 
+/// direct: UMFPACK sparse LU; gmres_ilu: Belos GMRES + Ifpack2 RILUK;
+/// gmres_amg: Belos GMRES + MueLu SA-AMG (rigid-body near-null space);
+/// eigen_lu: Eigen's SparseLU (single rank, a dependency-light reference).
+enum class LinearSolverType { direct, gmres_ilu, gmres_amg, eigen_lu };
+
+/// The names every input accepts (scene, case, fibers stage, CLI), in enum order.
+const std::vector<std::string>& linear_solver_names();
+const std::string& linear_solver_name(LinearSolverType type);
+/// Parses a name. An unknown one (an old spelling such as "gmres-amg" too)
+/// throws InputError: "<where>: '<name>' is not one of: ... (did you mean ...)".
+LinearSolverType parse_linear_solver(const std::string& name, const std::string& where);
+
 struct LinearSolverSettings {
-  /// "direct" (UMFPACK sparse LU), "gmres_ilu" (Belos GMRES + Ifpack2 RILUK),
-  /// "gmres_amg" (Belos GMRES + MueLu SA-AMG, rigid-body near-null space), "eigen_lu".
-  std::string type = "direct";
+  LinearSolverType type = LinearSolverType::direct;
   double tolerance = 1e-10;   // relative residual of the Krylov solver
   int max_iterations = 2000;
   int krylov_size = 200;      // the paper's choice
@@ -54,7 +65,6 @@ class LinearSolver {
   virtual std::string describe() const = 0;
 };
 
-/// Throws std::invalid_argument for an unknown type.
 std::unique_ptr<LinearSolver> make_linear_solver(const LinearSolverSettings& settings);
 
 /// The Eigen SparseLU reference solver (single rank).
@@ -62,8 +72,8 @@ std::unique_ptr<LinearSolver> make_eigen_lu_solver();
 /// SuiteSparse UMFPACK sparse LU (single rank; keeps the symbolic analysis
 /// while the pattern stays the same).
 std::unique_ptr<LinearSolver> make_umfpack_solver();
-/// "direct" (UMFPACK; on several ranks the matrix is gathered on rank 0),
-/// "gmres_ilu", "gmres_amg".
+/// direct (UMFPACK; on several ranks the matrix is gathered on rank 0),
+/// gmres_ilu, gmres_amg.
 std::unique_ptr<LinearSolver> make_trilinos_solver(const LinearSolverSettings& settings);
 
 }  // namespace stentsim::solver

@@ -65,11 +65,11 @@ class TrilinosSolver : public LinearSolver {
   void set_near_null_space(const Eigen::MatrixXd& modes) override { modes_ = modes; }
 
   std::string describe() const override {
-    if (settings_.type == "direct")
+    if (settings_.type == LinearSolverType::direct)
       return comm_->getSize() > 1 ? "direct: matrix gathered on rank 0, UMFPACK sparse LU there (serial)" : "UMFPACK sparse LU (direct)";
     std::ostringstream o;
     o << "Belos block GMRES (Krylov space " << settings_.krylov_size << ", tol " << settings_.tolerance << ") + ";
-    if (settings_.type == "gmres_ilu") o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
+    if (settings_.type == LinearSolverType::gmres_ilu) o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
     else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space, symmetric Gauss-Seidel)";
     else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node, symmetric Gauss-Seidel)";
     return o.str();
@@ -77,7 +77,7 @@ class TrilinosSolver : public LinearSolver {
 
   LinearSolveStats solve(const CsrMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x) override {
     // One rank: its contributions are the whole matrix, no Tpetra copy needed.
-    if (settings_.type == "direct" && comm_->getSize() == 1) return direct_->solve(a, b, x);
+    if (settings_.type == LinearSolverType::direct && comm_->getSize() == 1) return direct_->solve(a, b, x);
     LinearSolveStats stats;
     const auto t0 = Clock::now();
     const GO n = static_cast<GO>(a.rows);
@@ -87,7 +87,7 @@ class TrilinosSolver : public LinearSolver {
     // the Tpetra matrix is refilled in place and only compute() is redone.
     // (Not on several ranks: AdditiveSchwarz imports the overlap rows in
     // initialize() only, so a refilled matrix would leave them stale.)
-    const bool keep_ilu = settings_.type == "gmres_ilu" && comm_->getSize() == 1;
+    const bool keep_ilu = settings_.type == LinearSolverType::gmres_ilu && comm_->getSize() == 1;
     const bool reuse_ilu = keep_ilu && ilu_prec_ && a.row_ptr == ilu_row_ptr_ && a.cols == ilu_cols_;
     RCP<const Map> map;
     RCP<Matrix> mat;
@@ -103,7 +103,7 @@ class TrilinosSolver : public LinearSolver {
     for (LO i = 0; i < static_cast<LO>(map->getNodeNumElements()); ++i) bv->replaceLocalValue(i, 0, b(map->getGlobalElement(i)));
     xv->putScalar(0.0);
 
-    if (settings_.type == "direct" && comm_->getSize() > 1) {
+    if (settings_.type == LinearSolverType::direct && comm_->getSize() > 1) {
       // Amesos2 has only KLU2 and Tacho here, and KLU2 on a distributed matrix
       // returned wrong solutions with Debian's Trilinos 13.2 (caught by
       // test_solver_mpi_two_ranks): gather the assembled matrix on rank 0,
@@ -268,7 +268,7 @@ class TrilinosSolver : public LinearSolver {
   }
 
   RCP<OP> make_preconditioner(const RCP<Matrix>& mat, const RCP<const Map>& map, LinearSolveStats& stats) const {
-    if (settings_.type == "gmres_ilu") {
+    if (settings_.type == LinearSolverType::gmres_ilu) {
       using RowMatrix = Tpetra::RowMatrix<SC, LO, GO, NO>;
       Teuchos::ParameterList p;
       RCP<Ifpack2::Preconditioner<SC, LO, GO, NO>> prec;
@@ -288,7 +288,7 @@ class TrilinosSolver : public LinearSolver {
       prec->compute();
       return prec;
     }
-    if (settings_.type == "gmres_amg") {
+    if (settings_.type == LinearSolverType::gmres_amg) {
       Teuchos::ParameterList p;
       p.set("verbosity", std::string(settings_.verbosity > 0 ? "low" : "none"));
       p.set("multigrid algorithm", std::string("sa"));
@@ -324,7 +324,7 @@ class TrilinosSolver : public LinearSolver {
       stats.amg_levels = prec->GetHierarchy()->GetNumLevels();
       return prec;
     }
-    throw std::invalid_argument("unknown Krylov preconditioner for '" + settings_.type + "'");
+    throw std::invalid_argument("unknown Krylov preconditioner for '" + linear_solver_name(settings_.type) + "'");
   }
 
   LinearSolverSettings settings_;

@@ -7,6 +7,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "solver/terms/element_failure.hpp"
 
 namespace stentsim::solver {
 
@@ -29,7 +30,13 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
     for (;;) {
       double h = std::min(dt, next_stop - t);
       if (next_stop - (t + h) < 0.01 * h) h = next_stop - t;  // no sliver steps before a stop
-      NewtonResult nr = newton_step(model, system, linear, u, t + h, h, newton);
+      NewtonResult nr;
+      try {
+        model.begin_step(u, t + h, h);
+        nr = newton_step(model, system, linear, u, t + h, h, newton);
+      } catch (const ElementFailure& e) {
+        nr.failure = e.what();  // a term could not prepare the step (e.g. a contact search): cut it
+      }
       rec.newton_iterations += nr.iterations;
       rec.linear_iterations += nr.linear_iterations;
       rec.assembly_seconds += nr.assembly_seconds;

@@ -59,6 +59,12 @@ class Term {
   /// Adds R and dR/du at `state` (and the term's trial internal state).
   virtual void assemble(const SystemState& state, Assembler& out) = 0;
 
+  /// Called before every attempt of a load step, at the last converged state
+  /// (so also after a rollback), before the step's first assembly: a term that
+  /// keeps per-step data, such as a contact search, refreshes it here once per
+  /// step instead of once per residual evaluation.
+  virtual void begin_step(const SystemState& state) {}
+
   /// Multiplicative DOFs: set the trial state to (accepted iterate) composed
   /// with the increment `du` (global vector). May be called several times per
   /// iteration (line search); each call starts from the accepted iterate.

@@ -90,8 +90,8 @@ void check(bool quadratic, bool all_corners = false) {
   const fibers::LayerAngles angles{{tags::media, 0.0}, {tags::adventitia, 40 * M_PI / 180}};
   fibers::HarmonicFiberOptions o;
   o.angles = angles;
-  if (!quadratic) o.linear_solver = "direct";  // the three solver paths: direct, default AMG, ILU
-  if (all_corners) o.transmural_on_corners = true, o.linear_solver = "gmres_ilu";
+  if (!quadratic) o.linear_solver = solver::LinearSolverType::direct;  // the three solver paths: direct, default AMG, ILU
+  if (all_corners) o.transmural_on_corners = true, o.linear_solver = solver::LinearSolverType::gmres_ilu;
   fibers::TaggedTubeSpec axis;
   axis.length = kLength;
   const auto r = fibers::harmonic_fibers(mesh, fibers::tagged_tube_axis(axis), o);

@@ -97,7 +97,7 @@ TEST(HarmonicFibers, StraightTubeTet4MatchesAnalytic) {
   const MeshData mesh = tube(false);
   fibers::HarmonicFiberOptions o;
   o.angles = angles();
-  o.linear_solver = "direct";
+  o.linear_solver = solver::LinearSolverType::direct;
   const auto r = fibers::harmonic_fibers(mesh, straight_centerline(), o);
   const auto e = compare_with_analytic(mesh, r.fibers);
   std::printf("tet4 tube: mean angle error %.4f deg, max %.4f deg, neighbour fiber angle max %.2f deg, t in [%.3g, %.3g]\n",
@@ -149,7 +149,7 @@ TEST(HarmonicFibers, BentTubeFramesAreOrthonormalRightHandedAndSmooth) {
   const MeshData mesh = fibers::tagged_tube(spec);
   fibers::HarmonicFiberOptions o;
   o.angles = angles();
-  o.linear_solver = "direct";
+  o.linear_solver = solver::LinearSolverType::direct;
   const auto r = fibers::harmonic_fibers(mesh, fibers::tagged_tube_axis(spec, 0.3, 40), o);
   const auto& q = r.quality;
   std::printf("bent tube: orthonormality %.2e, handedness min %.6f, neighbour fiber angle max %.2f deg, frame %.2f deg, "
@@ -182,7 +182,7 @@ TEST(HarmonicFibers, BentTubeFramesAreOrthonormalRightHandedAndSmooth) {
 TEST(HarmonicFibers, BadInputIsAnError) {
   fibers::HarmonicFiberOptions o;
   o.angles = angles();
-  o.linear_solver = "direct";
+  o.linear_solver = solver::LinearSolverType::direct;
   const MeshData good = tube(false, 2, 16, 2);
   MeshData no_groups = good;
   no_groups.cell_data.erase(tags::kFaceGroup);

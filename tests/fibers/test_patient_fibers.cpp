@@ -47,7 +47,7 @@ const Patient& patient(bool quadratic) {
 fibers::HarmonicFiberOptions options(const std::string& solver) {
   fibers::HarmonicFiberOptions o;
   o.angles = {{tags::intima, 0.0}, {tags::media, 0.0}, {tags::adventitia, 40.0 * M_PI / 180}};
-  o.linear_solver = solver;
+  o.linear_solver = solver::parse_linear_solver(solver, "test");
   return o;
 }
 

@@ -77,7 +77,7 @@ TEST(SolverAmg, CoarsensSevenThousandDofsAndMatchesDirect) {
   auto p = block_system(10);  // 11 x 11 x 21 nodes = 7,623 DOFs
   ASSERT_GT(p->k.rows, 7000);
   LinearSolverSettings direct;
-  direct.type = "eigen_lu";  // SparseLU (COLAMD): the serial reference
+  direct.type = LinearSolverType::eigen_lu;  // SparseLU (COLAMD): the serial reference
   Eigen::VectorXd x_direct;
   auto t0 = std::chrono::steady_clock::now();
   const LinearSolveStats sd = make_linear_solver(direct)->solve(p->k, p->rhs, x_direct);
@@ -85,7 +85,7 @@ TEST(SolverAmg, CoarsensSevenThousandDofsAndMatchesDirect) {
   ASSERT_TRUE(sd.converged);
 
   LinearSolverSettings amg;
-  amg.type = "gmres_amg";
+  amg.type = LinearSolverType::gmres_amg;
   amg.tolerance = 1e-10;
   auto solver = make_linear_solver(amg);
   solver->set_near_null_space(p->modes);
@@ -119,7 +119,7 @@ TEST(SolverAmg, CoarsensSevenThousandDofsAndMatchesDirect) {
 TEST(SolverAmg, SmallSystemIsOneLevel) {
   auto p = block_system(3);  // 4 x 4 x 7 nodes = 336 DOFs: below the coarse size
   LinearSolverSettings amg;
-  amg.type = "gmres_amg";
+  amg.type = LinearSolverType::gmres_amg;
   auto solver = make_linear_solver(amg);
   solver->set_near_null_space(p->modes);
   Eigen::VectorXd x;
@@ -131,7 +131,7 @@ TEST(SolverAmg, SmallSystemIsOneLevel) {
 TEST(SolverAmg, NearNullSpaceMismatchIsAnError) {
   auto p = block_system(3);
   LinearSolverSettings amg;
-  amg.type = "gmres_amg";
+  amg.type = LinearSolverType::gmres_amg;
   Eigen::VectorXd x;
   {  // too few rows (e.g. built before further DOFs were allocated)
     auto solver = make_linear_solver(amg);
@@ -177,7 +177,7 @@ TEST(SolverAmg, ScenesChooseIt) {
   for (const char* type : {"direct", "gmres_amg"}) {
     SolveOptions o;
     o.output_dir = out / type;
-    o.linear_solver = type;
+    o.linear_solver = parse_linear_solver(type, "test");
     ASSERT_EQ(solve_scene(examples / "tube_inflation.yaml", o), 0) << type;
     r[k++] = std::get<double>(Summary::read(out / type / "summary.yaml").qois().at("inner_radius_at_pmax").value);
   }
@@ -185,7 +185,7 @@ TEST(SolverAmg, ScenesChooseIt) {
   // Beam bodies (6-9 DOFs per node, multipliers): refused with the scene's file and key, not left to a wrong coarse space.
   SolveOptions o;
   o.output_dir = out / "ring";
-  o.linear_solver = "gmres_amg";
+  o.linear_solver = solver::LinearSolverType::gmres_amg;
   try {
     solve_scene(examples / "stent_ring_expansion.yaml", o);
     ADD_FAILURE() << "gmres_amg accepted a beam scene";

@@ -95,7 +95,7 @@ TEST(BeamCommitState, NewtonCommitsTheHistoryOfTheConvergedState) {
     if (!touched.touched[static_cast<std::size_t>(d)]) model.constraints.fix(d, [](double) { return 0.0; });
   GlobalSystem system(model.constraints);
   LinearSolverSettings ls;
-  ls.type = "eigen_lu";
+  ls.type = LinearSolverType::eigen_lu;
   auto linear = make_linear_solver(ls);
   NewtonSettings ns;
   ns.residual_tolerance = 1e-3;  // loose: the accepted iterate differs from the previous one

@@ -91,7 +91,7 @@ struct TestSystem {
       if (!touched.touched[static_cast<std::size_t>(d)]) model.constraints.fix(d, [v = u[d]](double) { return v; });
     GlobalSystem system(model.constraints);
     LinearSolverSettings ls;
-    ls.type = "eigen_lu";
+    ls.type = LinearSolverType::eigen_lu;
     auto linear = make_linear_solver(ls);
     NewtonSettings ns;
     ns.max_iterations = max_iterations;

@@ -86,7 +86,7 @@ TEST(HgoTube, InflatesTo02MPaLikeTheReference) {
   }
   GlobalSystem sys(model.constraints);
   LinearSolverSettings ls;
-  ls.type = "eigen_lu";
+  ls.type = LinearSolverType::eigen_lu;
   auto linear = make_linear_solver(ls);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(model.dofs.size());
   StepperSettings st;

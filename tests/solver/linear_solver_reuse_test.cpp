@@ -106,7 +106,7 @@ TEST(Umfpack, ASingularMatrixIsAnErrorNotASolution) {
 
 TEST(Umfpack, TheDirectSolverOnOneRankIsUmfpack) {
   LinearSolverSettings s;
-  s.type = "direct";
+  s.type = LinearSolverType::direct;
   const auto solver = make_linear_solver(s);
   EXPECT_NE(solver->describe().find("UMFPACK"), std::string::npos) << solver->describe();
   const CsrMatrix a = grid_matrix(8, 0.3);
@@ -117,7 +117,7 @@ TEST(Umfpack, TheDirectSolverOnOneRankIsUmfpack) {
 
 TEST(IluReuse, RefilledMatrixAndRecomputedIluMatchAFreshSolver) {
   LinearSolverSettings s;
-  s.type = "gmres_ilu";
+  s.type = LinearSolverType::gmres_ilu;
   s.ilu_fill = 1;  // an inexact ILU, so the preconditioner's values matter
   s.tolerance = 1e-10;
   const auto kept = make_linear_solver(s);

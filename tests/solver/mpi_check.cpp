@@ -63,7 +63,7 @@ Eigen::VectorXd solve(int rank, int ranks, const std::string& linear_type) {
   }
   GlobalSystem sys(model.constraints);
   LinearSolverSettings ls;
-  ls.type = linear_type;
+  ls.type = parse_linear_solver(linear_type, "mpi check");
   ls.tolerance = 1e-12;
   auto linear = make_linear_solver(ls);
   if (linear_type == "gmres_amg") {

@@ -58,7 +58,7 @@ TEST(SolverNewton, QuadraticConvergenceAndSolverAgreement) {
     auto b = make_block(box_hex8(3, 3, 6, 1.0, 1.0, 2.0), 0.15);
     GlobalSystem sys(b->model.constraints);
     LinearSolverSettings ls;
-    ls.type = type;
+    ls.type = parse_linear_solver(type, "newton test");
     ls.tolerance = 1e-12;
     auto linear = make_linear_solver(ls);
     std::vector<std::pair<GlobalDof, Vec3>> nodes;

@@ -117,6 +117,16 @@ TEST(Restart, BeamRollupMatchesUninterruptedRun) {
   check_restart("beam_rollup", "cantilever", 4, {"tip_position", "tip_rotation_angle"});
 }
 
+// Contact: the active flags of the last converged state (the projection-failure rule),
+// the plastic history of the ring and the viscous history of the balloon are in the checkpoint.
+TEST(Restart, ContactRingOnBalloonMatchesUninterruptedRun) {
+  check_restart("contact_ring_on_balloon", "stent", 12, {"D_max", "D_end", "contact_force_stent_balloon_max"}, [](std::string t) {
+    for (std::string::size_type at; (at = t.find("file: data/")) != std::string::npos;)
+      t.replace(at, 11, "file: " + (kExamples / "data").string() + "/");
+    return t;
+  });
+}
+
 TEST(Restart, RejectsAForeignOrDamagedCheckpoint) {
   const auto dir = fresh_dir("bad");
   files::write_atomic(dir / "scene.yaml", with_checkpoints(files::read_text(kExamples / "beam_rollup.yaml"), 4));

@@ -83,7 +83,7 @@ TEST(SolverRobustness, InvertedTrialStateIsAFailedIterationNamingTheElement) {
   auto b = make_block(kPressure);
   GlobalSystem sys(b->model.constraints);
   LinearSolverSettings ls;
-  ls.type = "eigen_lu";
+  ls.type = LinearSolverType::eigen_lu;
   auto linear = make_linear_solver(ls);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
   const NewtonResult nr = newton_step(b->model, sys, *linear, u, 1.0, 1.0, no_line_search());
@@ -96,7 +96,7 @@ TEST(SolverRobustness, InvertedTrialStateIsAFailedIterationNamingTheElement) {
 
 TEST(SolverRobustness, InvertedTrialStateLeadsToACutAndTheSameAnswer) {
   LinearSolverSettings ls;
-  ls.type = "eigen_lu";
+  ls.type = LinearSolverType::eigen_lu;
   auto solve = [&](double dt, int* cuts) {
     auto b = make_block(kPressure);
     GlobalSystem sys(b->model.constraints);
@@ -121,7 +121,7 @@ TEST(SolverRobustness, FailureAtTheMinimumStepStopsWithTheElementAndTheLastState
   auto b = make_block(kPressure);
   GlobalSystem sys(b->model.constraints);
   LinearSolverSettings ls;
-  ls.type = "eigen_lu";
+  ls.type = LinearSolverType::eigen_lu;
   auto linear = make_linear_solver(ls);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
   StepperSettings st;

@@ -87,7 +87,7 @@ Radii solve_tube(const std::string& element, int nr, int nt, double height) {
   }
   GlobalSystem sys(model.constraints);
   LinearSolverSettings ls;
-  ls.type = "direct";
+  ls.type = LinearSolverType::direct;
   auto linear = make_linear_solver(ls);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(model.dofs.size());
   StepperSettings st;  // hyperelastic: the end state does not depend on the path

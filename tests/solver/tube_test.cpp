@@ -49,7 +49,7 @@ std::vector<double> fe_inner_radius(int nr, int nt, const std::string& solver, s
   }
   GlobalSystem sys(model.constraints);
   LinearSolverSettings ls;
-  ls.type = solver;
+  ls.type = parse_linear_solver(solver, "tube test");
   auto linear = make_linear_solver(ls);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(model.dofs.size());
   StepperSettings st;

@@ -16,7 +16,7 @@ namespace stentsim::cli {
 
 void register_fibers(CLI::App& app) {
   struct Args {
-    std::string mesh, centerline, out, solver = fibers::HarmonicFiberOptions{}.linear_solver;
+    std::string mesh, centerline, out, solver = solver::linear_solver_name(fibers::HarmonicFiberOptions{}.linear_solver);
     double intima = 0, media = 0, adventitia = 40, weight = 0.5;  // deg from circumferential (paper 4.2)
     bool quadratic = false;
   };
@@ -30,7 +30,9 @@ void register_fibers(CLI::App& app) {
   sub->add_option("--adventitia-angle", a->adventitia, "Adventitia fiber angle (+/-) from circumferential, deg")->capture_default_str();
   sub->add_option("--centerline-weight", a->weight, "Weight of the centerline tangent vs grad of the longitudinal coordinate (0..1)")
       ->capture_default_str();
-  sub->add_option("--linear-solver", a->solver, "gmres_ilu | gmres_amg | direct | eigen_lu")->capture_default_str();
+  sub->add_option("--linear-solver", a->solver, "Linear solver of the Laplace problems")
+      ->check(CLI::IsMember(solver::linear_solver_names()))
+      ->capture_default_str();
   sub->add_flag("--quadratic-laplace", a->quadratic,
                 "tet10: solve the longitudinal Laplace problem on all 10 nodes too (the transmural one always is) "
                 "instead of on the corner nodes");
@@ -39,7 +41,7 @@ void register_fibers(CLI::App& app) {
     const double rad = M_PI / 180.0;
     o.angles = {{tags::intima, a->intima * rad}, {tags::media, a->media * rad}, {tags::adventitia, a->adventitia * rad}};
     o.centerline_weight = a->weight;
-    o.linear_solver = a->solver;
+    o.linear_solver = solver::parse_linear_solver(a->solver, "--linear-solver");
     if (a->quadratic) o.linear_on_corners = false;
     Summary s;
     fibers::write_harmonic_fibers(a->mesh, a->centerline, o, a->out, s);

@@ -15,7 +15,7 @@ void register_solve(CLI::App& app) {
   sub->add_option("scene", a->scene, "Scene file (YAML)")->required();
   sub->add_option("--out", a->out, "Output folder (default: beside the scene file)");
   sub->add_option("--linear-solver", a->linear, "Override the scene's linear solver")
-      ->check(CLI::IsMember({"direct", "gmres_ilu", "gmres_amg", "eigen_lu"}));
+      ->check(CLI::IsMember(solver::linear_solver_names()));
   sub->add_flag("--verbose,-v", a->verbose, "Log every Newton iteration");
   auto* restart = sub->add_option("--restart", a->restart,
                                   "Resume from a checkpoint (output.checkpoint_every); default: OUT/checkpoint.bin")
@@ -23,7 +23,7 @@ void register_solve(CLI::App& app) {
   on(sub, [a, restart] {
     solver::SolveOptions o;
     o.output_dir = a->out;
-    if (!a->linear.empty()) o.linear_solver = a->linear;
+    if (!a->linear.empty()) o.linear_solver = solver::parse_linear_solver(a->linear, "--linear-solver");
     o.verbose = a->verbose;
     if (restart->count() > 0) o.restart = std::filesystem::path(a->restart);
     // solve_scene returns non-zero when the computation could not finish

@@ -229,8 +229,14 @@ StabilityOutcome classify_case(const StabilityCase& c, const ChildRun& run, cons
     return o;
   }
   if (c.kind != StabilityCase::Kind::exec && run.exit_code == 2) {
-    o.outcome = "failed uncleanly";
+    // An input error: "rejected" when it says why (a case may expect it, e.g. a device
+    // that starts inside the wall); unexpected everywhere else.
+    o.outcome = o.message.empty() ? "failed uncleanly" : "rejected";
     o.message = "input rejected: " + o.message;
+    if (o.outcome == "rejected" && !c.message.empty() && o.message.find(c.message) == std::string::npos) {
+      o.outcome = "failed uncleanly";
+      o.message += fmt::format(" (expected a message with '{}')", c.message);
+    }
     return o;
   }
   switch (c.kind) {
@@ -443,7 +449,7 @@ Summary stability_summary(const StabilityReport& r) {
   sum.set("cases_not_as_expected", static_cast<double>(r.unexpected()));
   // Every outcome class, zeros included, so a reader never has to guess
   // whether a missing count means none.
-  for (const char* outcome : {"converged", "failed cleanly", "failed uncleanly", "hang", "crash", "nan"}) {
+  for (const char* outcome : {"converged", "failed cleanly", "rejected", "failed uncleanly", "hang", "crash", "nan"}) {
     std::string name = std::string("cases_") + outcome;
     std::replace(name.begin(), name.end(), ' ', '_');
     sum.set(name, static_cast<double>(std::count_if(r.cases.begin(), r.cases.end(),

@@ -117,7 +117,8 @@ StabilitySuite load_stability_suite(const fs::path& file) {
       for (const auto& a : n) k.args.push_back(a.as<std::string>());
     }
     k.time_s = c.quantity("time", units::kTime, 6.0, Range::positive());
-    const std::string expect = c.choice("expect", {"converged", "failed cleanly", "converged or failed cleanly"}, "converged");
+    const std::string expect =
+        c.choice("expect", {"converged", "failed cleanly", "converged or failed cleanly", "rejected"}, "converged");
     k.expect = expect == "converged or failed cleanly" ? std::vector<std::string>{"converged", "failed cleanly"}
                                                         : std::vector<std::string>{expect};
     k.message = c.string("message", "");

@@ -1,0 +1,27 @@
+#pragma once
+// The solver's own part of checkpoint.bin (HistoryArchive keys "solver/…"):
+// the state vector, the time reached, the step size to try next and the run's
+// counters. Terms (Model::save_history), the results writer and the run
+// observers add their parts under their own prefixes.
+#include <Eigen/Core>
+
+#include "solver/terms/history_archive.hpp"
+
+namespace stentsim::solver {
+
+struct RunCounters {
+  long newton_iterations = 0, linear_iterations = 0, step_cuts = 0;
+  int steps = 0;
+};
+
+struct SolverCheckpoint {
+  Eigen::VectorXd u;
+  double time = 0.0, next_dt = 0.0;
+  RunCounters counters;
+
+  void put(HistoryArchive& out) const;
+  /// Reads it back; InputError (naming the checkpoint) when a field is missing or u has another size.
+  static SolverCheckpoint get(const HistoryArchive& in, long long dofs);
+};
+
+}  // namespace stentsim::solver

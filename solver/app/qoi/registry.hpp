@@ -1,0 +1,13 @@
+#pragma once
+// The QoI kinds, one factory per file; registry.cpp lists them.
+#include "solver/io/scene_kinds.hpp"
+
+namespace stentsim::solver {
+
+QoiKind mean_radius_qoi();
+QoiKind max_displacement_qoi();
+QoiKind tip_position_qoi();
+QoiKind tip_rotation_angle_qoi();
+QoiKind ring_expansion_qoi();
+
+}  // namespace stentsim::solver
