@@ -133,6 +133,9 @@ TEST(SolverScene, BadInputNamesFileAndKey) {
   expect_error("curve: ramp", "curve: rampp", "curve");
   expect_error("radius: 0.8 mm}}\n    value", "radius: 0.7 mm}}\n    value", "selects no boundary face");
   expect_error("type: direct", "type: cholesky", "type");
+  // Old spellings and misspelt kinds get the nearest name.
+  expect_error("type: direct", "type: gmres-amg", "did you mean 'gmres_amg'");
+  expect_error("type: pressure", "type: presure", "did you mean 'pressure'");
   expect_error("every: 1", "evry: 1", "evry");
   std::filesystem::remove_all(dir);
 }

@@ -15,7 +15,8 @@
 // Outputs: history.csv contact_<name>_force (Σ w |f|, N) and
 // contact_<name>_active_points; per sample point of the beam VTU
 // ContactLineLoad_<name> (N/mm, vector), ContactLineLoadMagnitude_<name>,
-// ContactGap_<name> (mm) from the element's nearest contact Gauss point;
+// ContactGap_<name> (mm; 0 where ContactProjected_<name> is 0: no face within
+// reach) from the element's nearest contact Gauss point;
 // summary.yaml contact_line_load_max_<name> (N/mm), contact_force_<name> (N),
 // contact_mean_penetration_<name> (mm, over the active points) and
 // contact_active_points_<name> at the end and, suffixed _<label>, at each of
@@ -79,7 +80,7 @@ class BeamToSurfaceOutput : public RunObserver {
       if (name != pair_.beam().name()) continue;
       const std::size_t ne = pair_.beam().body().elements.size();
       const std::size_t per = mesh.points.size() / ne;  // samples + 1 points per element, element-major
-      DataArray load{3, {}}, magnitude{1, {}}, gap{1, {}};
+      DataArray load{3, {}}, magnitude{1, {}}, gap{1, {}}, projected{1, {}};
       for (std::size_t e = 0; e < ne; ++e)
         for (std::size_t k = 0; k < per; ++k) {
           const double xi = per > 1 ? -1.0 + 2.0 * static_cast<double>(k) / static_cast<double>(per - 1) : 0.0;
@@ -90,11 +91,13 @@ class BeamToSurfaceOutput : public RunObserver {
           }
           for (int c = 0; c < 3; ++c) load.values.push_back(best->line_load[c]);
           magnitude.values.push_back(best->line_load.norm());
-          gap.values.push_back(best->projected ? best->gap : std::nan(""));
+          gap.values.push_back(best->projected ? best->gap : 0.0);  // ContactProjected tells where it is defined
+          projected.values.push_back(best->projected ? 1.0 : 0.0);
         }
       mesh.point_data["ContactLineLoad_" + pair_.name()] = load;
       mesh.point_data["ContactLineLoadMagnitude_" + pair_.name()] = magnitude;
       mesh.point_data["ContactGap_" + pair_.name()] = gap;
+      mesh.point_data["ContactProjected_" + pair_.name()] = projected;
     }
   }
   std::string checkpoint_name() const override { return "contact/" + pair_.name(); }

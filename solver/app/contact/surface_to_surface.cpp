@@ -12,8 +12,9 @@
 // Outputs: history.csv contact_<name>_force (Σ_j p_j A_j, the normal contact force summed
 // as magnitudes over the slave nodes, N, as the beam pairs' Σ w |f|) and
 // contact_<name>_active_nodes; point arrays on the slave body's frames
-// ContactPressure_<name> (MPa per current area) and ContactGap_<name> (the
-// nodal mean gap g̃_j/A_j, mm); summary.yaml contact_pressure_max_<name>,
+// ContactPressure_<name> (MPa per current area), ContactGap_<name> (the
+// nodal mean gap g̃_j/A_j, mm) and ContactSlave_<name> (1 on the slave surface,
+// where the other two are defined; 0 elsewhere); summary.yaml contact_pressure_max_<name>,
 // contact_force_<name>, contact_active_nodes_<name> at the end and, suffixed
 // _<label>, at each of `times`. A slave surface that starts inside the master
 // is an input error naming the place (DESIGN.md §8).
@@ -68,12 +69,16 @@ class SurfaceToSurfaceOutput : public RunObserver {
     const auto state = pair_.evaluate(u);
     for (auto& [name, mesh] : meshes) {
       if (name != slave_body_) continue;
-      DataArray pressure{1, std::vector<double>(mesh.points.size(), 0.0)}, gap{1, std::vector<double>(mesh.points.size(), std::nan(""))};
+      // Nodes off the slave surface: 0 (no NaN in outputs; ContactSlave tells them apart).
+      DataArray pressure{1, std::vector<double>(mesh.points.size(), 0.0)}, gap{1, std::vector<double>(mesh.points.size(), 0.0)},
+          slave{1, std::vector<double>(mesh.points.size(), 0.0)};
       for (const auto& n : state.nodes) {
         if (n.body_node >= mesh.points.size()) continue;
         pressure.values[n.body_node] = n.current_pressure;
         gap.values[n.body_node] = n.mean_gap;
+        slave.values[n.body_node] = 1.0;
       }
+      mesh.point_data["ContactSlave_" + pair_.name()] = slave;
       mesh.point_data["ContactPressure_" + pair_.name()] = pressure;
       mesh.point_data["ContactGap_" + pair_.name()] = gap;
     }
