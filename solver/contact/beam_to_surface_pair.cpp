@@ -85,6 +85,14 @@ bool BeamToSurfacePair::moved_too_far(const Eigen::VectorXd& u) const {
 
 void BeamToSurfacePair::refresh_search(const Eigen::VectorXd& u) {
   search(*surface_, u, candidates_);
+  const double grow = settings_.radius + settings_.law.active_limit() + 2.0 * margin_;
+  face_boxes_.assign(surface_->faces().size(), Eigen::AlignedBox3d());
+  for (std::size_t f = 0; f < face_boxes_.size(); ++f) {
+    const SurfaceFace& face = surface_->faces()[f];
+    for (int k = 0; k < face.count; ++k) face_boxes_[f].extend(surface_->x(face.node[k]));
+    face_boxes_[f].min().array() -= grow;
+    face_boxes_[f].max().array() += grow;
+  }
   ++searches_;
   pattern_reserved_ = false;
   searched_points_.clear();
@@ -107,7 +115,8 @@ void BeamToSurfacePair::begin_step(const SystemState& state) {
 }
 
 NormalProjection BeamToSurfacePair::project(const ContactSurface& surface, const std::vector<int>& faces, const Vec3& p,
-                                            int& face, Reach& where, int* unconverged) const {
+                                            int& face, Reach& where, int* unconverged,
+                                            const std::vector<Eigen::AlignedBox3d>* boxes) const {
   NormalProjection best;
   face = -1;
   where = Reach::nowhere;
@@ -115,6 +124,11 @@ NormalProjection BeamToSurfacePair::project(const ContactSurface& surface, const
   const double reach = settings_.radius + settings_.law.active_limit() + margin_;
   bool apart = false, deep = false;
   for (int f : faces) {
+    // Outside the face's grown box: farther than the reach from it (apart from this face).
+    if (boxes && !(*boxes)[static_cast<std::size_t>(f)].contains(p)) {
+      apart = true;
+      continue;
+    }
     const NormalProjection pr = project_along_normals(surface, f, p, settings_.inside_tolerance);
     if (pr.kind == ProjectionKind::not_converged && unconverged) ++*unconverged;
     if (pr.kind != ProjectionKind::inside) continue;
@@ -164,7 +178,8 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       for (int k = 0; k < nc_; ++k) p += gp.B[static_cast<std::size_t>(k)] * x[static_cast<std::size_t>(k)];
       int face = -1;
       Reach where = Reach::nowhere;
-      const NormalProjection pr = project(*surface_, candidates_[e].faces, p, face, where, tangent ? &unconverged : nullptr);
+      const NormalProjection pr =
+          project(*surface_, candidates_[e].faces, p, face, where, tangent ? &unconverged : nullptr, &face_boxes_);
       // A point in contact in the last converged state that now projects nowhere, or far through the
       // surface, would silently lose its force: a failed iteration instead (the step is cut).
       if (active_committed_[id] && (where == Reach::nowhere || where == Reach::deep))
@@ -251,18 +266,32 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       patch_of(b.face, patch);
       auto slot = [&](int n) { return nq + 3 * static_cast<int>(std::lower_bound(patch.begin(), patch.end(), n) - patch.begin()); };
       const int M = nq + 3 * static_cast<int>(patch.size()), nv = nq + 6 * f.count;
-      Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nv, M);
-      T.topLeftCorner(nq, nq).setIdentity();
+      // T = ∂v'/∂(DOFs) by its 3 x 3 blocks, never formed: per triple t of v' the (column slot,
+      // block) pairs — identity for the beam vectors and the face nodes, the nodal normals'
+      // Jacobian blocks over their patches. Applied to columns (K' T) and to rows (Tᵀ ·).
+      std::vector<std::vector<std::pair<int, Mat3>>> map(static_cast<std::size_t>(nv / 3));
+      for (int t = 0; t < nq / 3; ++t) map[static_cast<std::size_t>(t)].emplace_back(3 * t, Mat3::Identity());
       for (int k = 0; k < f.count; ++k) {
-        T.block<3, 3>(nq + 3 * k, slot(f.node[k])).setIdentity();
+        map[static_cast<std::size_t>(nq / 3 + k)].emplace_back(slot(f.node[k]), Mat3::Identity());
         const NormalDerivatives& nd = surface_->normal_derivatives(f.node[k], potential);
+        auto& nk = map[static_cast<std::size_t>(nq / 3 + f.count + k)];
         for (std::size_t m = 0; m < nd.patch.size(); ++m)
-          T.block<3, 3>(nq + 3 * f.count + 3 * k, slot(nd.patch[m])) += nd.jacobian.block<3, 3>(0, 3 * static_cast<int>(m));
+          nk.emplace_back(slot(nd.patch[m]), nd.jacobian.block<3, 3>(0, 3 * static_cast<int>(m)));
       }
-      const Eigen::VectorXd r = T.transpose() * b.g;
+      // Gap variation: no residual on the normals (their rows of g' and K' are zero).
+      const int row_triples = potential ? nv / 3 : nq / 3 + f.count;
+      Eigen::VectorXd r = Eigen::VectorXd::Zero(M);
+      for (int t = 0; t < row_triples; ++t)
+        for (const auto& [col, J] : map[static_cast<std::size_t>(t)]) r.segment<3>(col) += J.transpose() * b.g.segment<3>(3 * t);
       Eigen::MatrixXd K;
       if (tangent) {
-        K = T.transpose() * b.k * T;
+        Eigen::MatrixXd KT = Eigen::MatrixXd::Zero(3 * row_triples, M);
+        for (int t = 0; t < nv / 3; ++t)
+          for (const auto& [col, J] : map[static_cast<std::size_t>(t)])
+            KT.middleCols<3>(col) += b.k.block(0, 3 * t, 3 * row_triples, 3) * J;
+        K = Eigen::MatrixXd::Zero(M, M);
+        for (int t = 0; t < row_triples; ++t)
+          for (const auto& [row, J] : map[static_cast<std::size_t>(t)]) K.middleRows<3>(row) += J.transpose() * KT.middleRows<3>(3 * t);
         for (int k = 0; k < f.count && potential; ++k) {
           const NormalDerivatives& nd = surface_->normal_derivatives(f.node[k], true);
           std::vector<int> s(nd.patch.size());

@@ -114,7 +114,7 @@ class BeamToSurfacePair : public Term {
   /// `unconverged` counts the candidates whose local Newton did not converge).
   enum class Reach { near, apart, deep, nowhere };
   NormalProjection project(const ContactSurface& surface, const std::vector<int>& faces, const Vec3& p, int& face, Reach& reach,
-                           int* unconverged = nullptr) const;
+                           int* unconverged = nullptr, const std::vector<Eigen::AlignedBox3d>* boxes = nullptr) const;
   bool moved_too_far(const Eigen::VectorXd& u) const;
   /// Search at u and remember the positions it was made at.
   void refresh_search(const Eigen::VectorXd& u);
@@ -127,6 +127,9 @@ class BeamToSurfacePair : public Term {
   int nc_ = 4;  // centerline vectors per element
   std::vector<std::vector<GaussPoint>> gauss_;  // per element
   std::vector<Candidates> candidates_;           // per element, from the last search
+  /// Per face, its box at the last search grown by the reach and the margin (what it may move
+  /// before the next search): a point outside it cannot project onto the face within reach.
+  std::vector<Eigen::AlignedBox3d> face_boxes_;
   std::vector<Vec3> searched_points_, searched_nodes_;
   bool pattern_reserved_ = false;
   std::vector<char> active_committed_, active_trial_;  // per Gauss point (element-major)
