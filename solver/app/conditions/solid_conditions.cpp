@@ -10,6 +10,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "solver/app/body_surfaces.hpp"
 #include "solver/app/built_model.hpp"
 #include "solver/app/conditions/registry.hpp"
 #include "solver/io/selection.hpp"
@@ -21,12 +22,7 @@ namespace {
 /// The selected boundary faces of the body (of its solid cells), never empty.
 std::vector<fem::Face> selected_faces(const SceneDesc& scene, const std::string& condition, const SolidBody& body,
                                       const Selector& where) {
-  std::vector<bool> active(body.mesh().num_cells());
-  for (std::size_t i = 0; i < active.size(); ++i) active[i] = body.cell_material()[i] >= 0;
-  auto faces = select_faces(body.mesh(), fem::boundary_faces(body.mesh(), active), where);
-  if (faces.empty())
-    throw InputError(fmt::format("{}: condition '{}': the surface selection ({}) selects no boundary face of body '{}'",
-                                 scene.file.string(), condition, where.describe(), body.name()));
+  auto faces = selected_boundary_faces(scene, fmt::format("condition '{}'", condition), body, where);
   log::info("condition '{}': {} faces of body '{}'", condition, faces.size(), body.name());
   return faces;
 }

@@ -29,6 +29,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "solver/app/body_surfaces.hpp"
 #include "solver/app/built_model.hpp"
 #include "solver/app/contact/registry.hpp"
 #include "solver/app/contact/strut_overlap.hpp"
@@ -158,12 +159,7 @@ class BeamToSurfaceSpec : public ContactSpec {
     const std::string file = scene.file.string();
     const beams::BeamTerm& beam_term = m.beam(beam);
     SolidBody& body = m.solid(solid);
-    std::vector<bool> active(body.mesh().num_cells());
-    for (std::size_t i = 0; i < active.size(); ++i) active[i] = body.cell_material()[i] >= 0;
-    auto faces = select_faces(body.mesh(), fem::boundary_faces(body.mesh(), active), surface);
-    if (faces.empty())
-      throw InputError(fmt::format("{}: contact '{}': the surface selection ({}) selects no boundary face of body '{}'", file, name,
-                                   surface.describe(), solid));
+    const auto faces = selected_boundary_faces(scene, fmt::format("contact '{}'", name), body, surface);
     contact::BeamToSurfaceSettings s = settings;
     if (!radius_given) {
       s.radius = beam_term.body().section.radius;
@@ -226,17 +222,7 @@ ContactKind beam_to_surface_contact() {
                                    : contact::BeamContactForm::gap_variation;
             s->settings.search_margin = c.quantity("search_margin", units::kLength, 0.0, Range::non_negative());
             s->settings.max_flips = c.integer("max_flips", 8, Range::between(1, 1000));
-            if (auto t = c.optional_map("times")) {
-              for (const auto& kv : t->node()) {
-                const std::string label = kv.first.Scalar();
-                const double at = t->quantity(label, units::kTime);
-                if (!(at > r.scene.stepping.t_start && at <= r.scene.stepping.t_end))
-                  t->fail(label, "must lie inside solver.time");
-                s->times[label] = at;
-                r.scene.stepping.stops.push_back(at);
-              }
-              t->finish();
-            }
+            s->times = read_report_times(c, "times", r);
             return s;
           }};
 }

@@ -25,6 +25,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "solver/app/body_surfaces.hpp"
 #include "solver/app/built_model.hpp"
 #include "solver/app/contact/registry.hpp"
 #include "solver/app/run_observer.hpp"
@@ -135,12 +136,7 @@ class SurfaceToSurfaceSpec : public ContactSpec {
   std::unique_ptr<contact::ContactSurface> surface(const SceneDesc& scene, BuiltModel& m, const SideDesc& side,
                                                    const char* role) const {
     SolidBody& body = m.solid(side.body);
-    std::vector<bool> active(body.mesh().num_cells());
-    for (std::size_t i = 0; i < active.size(); ++i) active[i] = body.cell_material()[i] >= 0;
-    auto faces = select_faces(body.mesh(), fem::boundary_faces(body.mesh(), active), side.surface);
-    if (faces.empty())
-      throw InputError(fmt::format("{}: contact '{}': the {} surface selection ({}) selects no boundary face of body '{}'",
-                                   scene.file.string(), name, role, side.surface.describe(), side.body));
+    const auto faces = selected_boundary_faces(scene, fmt::format("contact '{}' ({})", name, role), body, side.surface);
     return std::make_unique<contact::ContactSurface>(name + ":" + side.body, body, faces);
   }
 
@@ -201,16 +197,7 @@ ContactKind surface_to_surface_contact() {
             s->settings.gauss_points = c.integer("gauss_points", 4, Range::between(1, 32));
             s->settings.search_margin = c.quantity("search_margin", units::kLength, 0.0, Range::non_negative());
             s->settings.max_flips = c.integer("max_flips", 8, Range::between(1, 1000));
-            if (auto t = c.optional_map("times")) {
-              for (const auto& kv : t->node()) {
-                const std::string label = kv.first.Scalar();
-                const double at = t->quantity(label, units::kTime);
-                if (!(at > r.scene.stepping.t_start && at <= r.scene.stepping.t_end)) t->fail(label, "must lie inside solver.time");
-                s->times[label] = at;
-                r.scene.stepping.stops.push_back(at);
-              }
-              t->finish();
-            }
+            s->times = read_report_times(c, "times", r);
             return s;
           }};
 }
