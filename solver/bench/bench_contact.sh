@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Contact benchmark at the paper's scale (issue 18): the 11-ring stent (588
+# Contact benchmark at the paper's scale: the 11-ring stent (588
 # Hermite elements, 6 Gauss points each: 3,528 beam points per beam pair, 7,056
 # over both) against the 18 mm balloon (35 x 79 = 2,765 hex8, its outer face)
 # and a tet10 wall tube around them; the balloon's outer face against the wall
