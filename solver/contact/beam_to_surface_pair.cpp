@@ -8,7 +8,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
-#include "solver/assembly/parallel.hpp"
+#include "solver/contact/owned_flags.hpp"
 #include "solver/terms/element_failure.hpp"
 
 namespace stentsim::solver::contact {
@@ -360,16 +360,7 @@ std::vector<BeamContactPoint> BeamToSurfacePair::evaluate(const Eigen::VectorXd&
 }
 
 void BeamToSurfacePair::commit() {
-  if (ranks_ > 1) {
-    const std::size_t ne = gauss_.size(), ng = static_cast<std::size_t>(settings_.gauss_points);
-    Eigen::VectorXd flags = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(active_trial_.size()));
-    const SystemState owner{flags, 0.0, 0.0, rank_, ranks_};
-    for (std::size_t e = 0; e < ne; ++e)
-      if (owner.owns(e, ne))
-        for (std::size_t g = 0; g < ng; ++g) flags[static_cast<Eigen::Index>(e * ng + g)] = active_trial_[e * ng + g];
-    parallel::sum(flags);
-    for (std::size_t i = 0; i < active_trial_.size(); ++i) active_trial_[i] = flags[static_cast<Eigen::Index>(i)] != 0.0;
-  }
+  gather_owned_flags(active_trial_, static_cast<std::size_t>(settings_.gauss_points), rank_, ranks_);
   active_committed_ = active_trial_;
   if (unconverged_ > 0)
     log::warn("contact '{}': {} projections onto candidate faces did not converge in the converged state (those points count as "

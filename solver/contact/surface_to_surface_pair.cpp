@@ -8,7 +8,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
-#include "solver/assembly/parallel.hpp"
+#include "solver/contact/owned_flags.hpp"
 #include "solver/beams/element_reference.hpp"
 #include "solver/contact/face_search.hpp"
 #include "solver/terms/element_failure.hpp"
@@ -439,16 +439,7 @@ SurfaceContactState SurfaceToSurfacePair::evaluate(const Eigen::VectorXd& u) con
 }
 
 void SurfaceToSurfacePair::commit() {
-  // Every rank evaluated its own slave nodes only: gather the flags so that every rank (and rank 0's checkpoint) holds all.
-  if (ranks_ > 1) {
-    const std::size_t ns = active_trial_.size();
-    Eigen::VectorXd flags = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ns));
-    const SystemState owner{flags, 0.0, 0.0, rank_, ranks_};
-    for (std::size_t j = 0; j < ns; ++j)
-      if (owner.owns(j, ns)) flags[static_cast<Eigen::Index>(j)] = active_trial_[j];
-    parallel::sum(flags);
-    for (std::size_t j = 0; j < ns; ++j) active_trial_[j] = flags[static_cast<Eigen::Index>(j)] != 0.0;
-  }
+  gather_owned_flags(active_trial_, 1, rank_, ranks_);  // one flag per slave node
   active_committed_ = active_trial_;
 }
 
