@@ -69,6 +69,14 @@ pid_t spawn(const std::function<int()>& body, const ChildSetup& setup) {
   return pid;
 }
 
+fs::path self_executable() {
+  char buf[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) throw ComputeError("cannot find the stentsim executable (/proc/self/exe)");
+  buf[n] = '\0';
+  return fs::path(buf);
+}
+
 pid_t spawn_exec(const std::vector<std::string>& argv_s, const ChildSetup& setup) {
   if (argv_s.empty()) throw ComputeError("cannot start a child process: empty command");
   return spawn(

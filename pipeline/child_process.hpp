@@ -38,6 +38,10 @@ struct ChildSetup {
 /// returns into the caller. Throws ComputeError when fork fails.
 pid_t spawn(const std::function<int()>& body, const ChildSetup& setup = {});
 
+/// This program's executable (/proc/self/exe), to start stentsim itself as a
+/// child (an MPI run, a study's runs). Throws ComputeError when unknown.
+std::filesystem::path self_executable();
+
 /// Forks and executes argv (execvp: argv[0] is looked up in PATH unless it
 /// holds a '/'). Exit 127 when it cannot execute (the reason is in the log),
 /// 126 when the working folder cannot be entered.

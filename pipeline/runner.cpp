@@ -178,6 +178,20 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
         files::replace(r.temp_dir / declared, target);
       }
     }
+    // A failed stage's partial outputs (a solve's last converged frame, its
+    // history) are moved to failed/<stage>/ for the user; nothing in place is
+    // touched. A finished run of the stage replaces what an earlier one kept.
+    const fs::path kept = plan_.work_dir() / "failed" / s.name;
+    bool kept_partial = false;
+    if (!o.interrupted && !g_stop_signal) {
+      std::error_code ec;
+      fs::remove_all(kept, ec);
+      if (!o.ok && fs::exists(r.temp_dir) && !fs::is_empty(r.temp_dir)) {
+        fs::create_directories(kept.parent_path(), ec);
+        fs::rename(r.temp_dir, kept, ec);
+        kept_partial = !ec;
+      }
+    }
     fs::remove_all(r.temp_dir);
     StageRecord rec;
     rec.version = s.version;
@@ -207,6 +221,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       failing = true;
       out << fmt::format("  FAIL  {:<13} {}\n", s.name, o.message);
       out << fmt::format("        log: {}\n", (plan_.work_dir() / "logs" / (s.name + ".log")).string());
+      if (kept_partial) out << fmt::format("        partial outputs: {}\n", kept.string());
     }
     out.flush();
   };

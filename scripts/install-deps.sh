@@ -23,6 +23,8 @@ PKGS=(
   libplplot-dev plplot-driver-cairo
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # headless browser: the report test renders report.html to a screenshot
+  chromium
   # Slurm back-end of `stentsim cohort` (its tests start a private single-node cluster)
   slurmctld slurmd slurm-client munge
 )

@@ -141,6 +141,7 @@ BeamBodyDesc read_beam_body(ConfigMap& beam) {
     d.body = std::move(s.body);
     d.joints = std::move(s.joints);
     d.fixations = std::move(s.fixations);
+    d.element_ring = std::move(s.element_ring);
     d.source = path.string();
     d.body.gauss_points = beam.integer("gauss_points", 0, Range::between(0, 10));
     make_plastic(d, mat, beam);

@@ -43,6 +43,7 @@ struct BeamBodyDesc {
   BeamBodyDefinition body;
   std::vector<std::array<int, 2>> joints;           // from a stent file
   std::vector<StentBeams::Fixation> fixations;      // from a stent file
+  std::vector<int> element_ring;                    // from a stent file: ring per element, −1 connectors
   std::string source;                               // file name or generator, for logs and the summary
   bool couple_joints = true;                        // `joints: rigid` (default) or `none`
   JointMap joint_map;                               // identity when no joints are coupled

@@ -30,6 +30,10 @@ StentBeams stent_beams_from_mesh(const MeshData& mesh, double E, double G, const
   const DataArray& radius = need(mesh.cell_data, "SectionRadius", 1, nc, where, "cell");
   const DataArray& direction = need(mesh.cell_data, "Direction", 3, nc, where, "cell");
 
+  const auto kind_it = mesh.cell_data.find("MemberKind"), ring_it = mesh.cell_data.find("Ring");
+  const bool rings = kind_it != mesh.cell_data.end() && ring_it != mesh.cell_data.end();
+  if (rings) need(mesh.cell_data, "MemberKind", 1, nc, where, "cell"), need(mesh.cell_data, "Ring", 1, nc, where, "cell");
+
   StentBeams s;
   s.body.interpolation = BeamInterpolation::hermite3;
   for (std::size_t i = 0; i < np; ++i) {
@@ -55,6 +59,8 @@ StentBeams stent_beams_from_mesh(const MeshData& mesh, double E, double G, const
         throw InputError(where + ": beams with different SectionRadius are not supported (cell " +
                          std::to_string(c) + ")");
       s.body.elements.push_back({static_cast<int>(nodes[0]), static_cast<int>(nodes[1]), static_cast<int>(nodes[2])});
+      // MemberKind 0 = strut (Ring = its ring), 1 = connector (Ring = the gap it bridges).
+      if (rings) s.element_ring.push_back(kind_it->second.at(c) == 0 ? static_cast<int>(ring_it->second.at(c)) : -1);
     } else if (r == 1) {
       if (nodes.size() != 2) throw InputError(where + ": joint cell " + std::to_string(c) + " must be a node pair");
       s.joints.push_back({static_cast<int>(nodes[0]), static_cast<int>(nodes[1])});

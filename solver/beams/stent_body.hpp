@@ -24,6 +24,9 @@ struct StentBeams {
     bool axial;  // false: moves only along `direction`; true: fixed along `direction`
   };
   std::vector<Fixation> fixations;
+  /// Per beam element: its ring (struts), −1 for connectors; empty when the
+  /// file has no MemberKind/Ring arrays (the stent QoI needs them).
+  std::vector<int> element_ring;
 };
 
 /// Builds the body from a stent mesh with an elastic circular section of

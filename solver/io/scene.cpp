@@ -165,8 +165,18 @@ void SceneReader::axis(ConfigMap& c, const std::string& key, Vec3& origin, Vec3&
   }
 }
 
-SceneDesc read_scene(const std::filesystem::path& file) {
-  ConfigMap root = ConfigMap::load(file);
+namespace {
+SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file);
+}
+
+SceneDesc read_scene(const std::filesystem::path& file) { return read_scene_root(ConfigMap::load(file), file); }
+
+SceneDesc read_scene(const std::string& text, const std::filesystem::path& file) {
+  return read_scene_root(ConfigMap::from_string(text, file), file);
+}
+
+namespace {
+SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   SceneDesc scene;
   scene.file = file;
   scene.description = root.string("description", "");
@@ -330,5 +340,7 @@ SceneDesc read_scene(const std::filesystem::path& file) {
   root.finish();
   return scene;
 }
+
+}  // namespace
 
 }  // namespace stentsim::solver

@@ -71,5 +71,8 @@ struct SceneDesc {
 
 /// Reads and validates a scene; meshes are read or generated.
 SceneDesc read_scene(const std::filesystem::path& file);
+/// The same from the text of a scene that lives (or will live) at `file`:
+/// relative paths resolve against its folder and errors name it.
+SceneDesc read_scene(const std::string& text, const std::filesystem::path& file);
 
 }  // namespace stentsim::solver

@@ -54,6 +54,9 @@ class QoiSpec {
  public:
   virtual ~QoiSpec() = default;
   std::string name, body;
+  /// Writes summary keys without its name as prefix (recoil_percent, D_max …):
+  /// a scene holds at most one such QoI.
+  virtual bool unprefixed() const { return false; }
   /// The observer that evaluates it during the run and writes its summary entries.
   virtual std::unique_ptr<RunObserver> observer(const SceneDesc& scene, const BuiltModel& model) const = 0;
 };

@@ -166,6 +166,28 @@ TEST_F(RunnerTest, FailingStageLeavesEarlierOutputsAndReportsIt) {
   EXPECT_EQ(count("c"), 2);
 }
 
+TEST_F(RunnerTest, FailedStageKeepsItsPartialOutputsForTheUser) {
+  run();
+  const std::string before = files::read_text(work / "b/out.txt");
+  config["b"] = "q=2 halfway";
+  auto rep = run();
+  EXPECT_EQ(rep.failed, (std::vector<std::string>{"b"}));
+  EXPECT_EQ(files::read_text(work / "b/out.txt"), before);  // the earlier artifact is untouched
+  EXPECT_EQ(files::read_text(work / "failed" / "b" / "b" / "out.txt"), "last converged\n");
+  EXPECT_NE(last_output.find("partial outputs: " + (work / "failed" / "b").string()), std::string::npos) << last_output;
+  EXPECT_FALSE(fs::exists(work / ".tmp" / "b"));
+  // A later run of the stage, failing cleanly or succeeding, removes the old keep.
+  config["b"] = "fail";
+  run();
+  EXPECT_FALSE(fs::exists(work / "failed" / "b"));
+  config["b"] = "q=2 halfway";
+  run();
+  ASSERT_TRUE(fs::exists(work / "failed" / "b"));
+  config["b"] = "q=3";
+  EXPECT_EQ(run().exit_code(), 0);
+  EXPECT_FALSE(fs::exists(work / "failed" / "b"));
+}
+
 TEST_F(RunnerTest, CrashingStageDoesNotTakeTheRunnerDown) {
   config["d"] = "crash";
   auto rep = run();

@@ -24,7 +24,8 @@ inline int run_count(const std::filesystem::path& counters, const std::string& s
 }
 
 /// A stage `name` reading `inputs`, writing `output`. Its config may contain
-/// the words "fail", "crash" or "sleep" to fail, abort or sleep 30 s.
+/// the words "fail", "crash" or "sleep" to fail, abort or sleep 30 s; "halfway"
+/// writes its output and then fails.
 inline pipeline::Stage concat_stage(const std::string& name, std::vector<std::string> inputs, const std::string& output,
                                     const std::string& config, const std::filesystem::path& counters) {
   pipeline::Stage s;
@@ -58,6 +59,11 @@ inline pipeline::Stage concat_stage(const std::string& name, std::vector<std::st
       return;
     }
     if (config.find("crash") != std::string::npos) std::abort();
+    if (config.find("halfway") != std::string::npos) {
+      // Writes what a solve that diverged leaves (its last frame), then fails.
+      files::write_atomic(ctx.output(output), "last converged\n");
+      throw ComputeError("deliberate failure of " + name + " halfway");
+    }
     if (config.find("fail") != std::string::npos) throw InputError("deliberate failure of " + name);
     std::string text;
     for (const auto& in : ctx.stage().inputs) text += files::read_text(ctx.input(in));

@@ -9,6 +9,7 @@
 
 #include "common/config.hpp"
 #include "common/error.hpp"
+#include "pipeline/child_process.hpp"
 #include "pipeline/runner.hpp"
 #include "workflows/case_config.hpp"
 #include "workflows/case_stages.hpp"
@@ -21,12 +22,6 @@
 namespace stentsim::cli {
 namespace {
 
-std::string self_binary() {
-  char buf[4096];
-  ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) throw ComputeError("cannot find the stentsim executable (/proc/self/exe)");
-  return std::string(buf, static_cast<std::size_t>(n));
-}
 
 std::vector<std::string> split(const std::string& s) {
   std::vector<std::string> out;
@@ -138,7 +133,7 @@ void register_cohort(CLI::App& app) {
     o.dry_run = a->dry_run;
     o.workers = a->workers;
     o.only_cases = split(a->cases);
-    o.binary = self_binary();
+    o.binary = pipeline::self_executable().string();
     std::vector<std::pair<std::string, std::string>> stage_args;
     if (!a->until.empty()) stage_args.emplace_back("--until", a->until);
     if (!a->only.empty()) stage_args.emplace_back("--only", a->only);

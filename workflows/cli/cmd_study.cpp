@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "common/error.hpp"
+#include "pipeline/child_process.hpp"
 #include "workflows/cli/commands.hpp"
 #include "workflows/study/error_study.hpp"
 #include "workflows/study/stability/stability_command.hpp"
@@ -14,12 +15,6 @@
 namespace stentsim::cli {
 namespace {
 
-std::string study_binary() {
-  char buf[4096];
-  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) throw ComputeError("cannot find the stentsim executable (/proc/self/exe)");
-  return std::string(buf, static_cast<std::size_t>(n));
-}
 
 }  // namespace
 
@@ -46,7 +41,7 @@ void register_study(CLI::App& app) {
     o.yes = a->yes;
     o.reuse_timings = a->reuse;
     o.jobs = a->jobs;
-    o.binary = study_binary();
+    o.binary = pipeline::self_executable().string();
     return study::run_error_study(a->file, o, std::cout);
   });
   auto* stab = study->add_subcommand("stability", "Stiff and extreme cases: converge or fail cleanly (suite, outcome table)");

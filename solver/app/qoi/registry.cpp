@@ -4,7 +4,8 @@ namespace stentsim::solver {
 
 const std::vector<QoiKind>& qoi_kinds() {
   static const std::vector<QoiKind> kinds{mean_radius_qoi(), max_displacement_qoi(), tip_position_qoi(),
-                                          tip_rotation_angle_qoi(), ring_expansion_qoi()};
+                                          tip_rotation_angle_qoi(), ring_expansion_qoi(),
+                                          stent_expansion_qoi(), balloon_profile_qoi()};
   return kinds;
 }
 

@@ -9,5 +9,7 @@ QoiKind max_displacement_qoi();
 QoiKind tip_position_qoi();
 QoiKind tip_rotation_angle_qoi();
 QoiKind ring_expansion_qoi();
+QoiKind stent_expansion_qoi();
+QoiKind balloon_profile_qoi();
 
 }  // namespace stentsim::solver

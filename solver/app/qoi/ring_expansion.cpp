@@ -10,6 +10,7 @@
 
 #include "common/error.hpp"
 #include "solver/app/built_model.hpp"
+#include "solver/app/qoi/beam_measures.hpp"
 #include "solver/app/qoi/registry.hpp"
 #include "solver/app/run_observer.hpp"
 
@@ -21,6 +22,7 @@ class RingSpec : public QoiSpec {
   beams::BeamNodeSelector node;
   Vec3 origin = Vec3::Zero(), axis = Vec3::UnitZ();
   double peak_time = 0.0;
+  bool unprefixed() const override { return true; }
   std::unique_ptr<RunObserver> observer(const SceneDesc& scene, const BuiltModel& m) const override;
 };
 
@@ -116,13 +118,7 @@ class RingExpansion : public RunObserver {
       for (GlobalDof d = first; d < first + count; ++d) r = std::max(r, std::abs(u[d]));
     return r;
   }
-  /// Largest ‖M_b‖ over every Gauss point of the body at u (committed history).
-  double max_bending_moment(const Eigen::VectorXd& u) const {
-    double mb = 0.0;
-    for (std::size_t e = 0; e < beam_.body().elements.size(); ++e)
-      for (const auto& st : beam_.section_states(u, e)) mb = std::max(mb, st.M.tail<2>().norm());
-    return mb;
-  }
+  double max_bending_moment(const Eigen::VectorXd& u) const { return solver::max_bending_moment(beam_, u); }
   /// Radial force on the body (−λ) and radial displacement of every radial_displacement node,
   /// for the external work (the other conditions hold zero displacement components: no work).
   std::vector<std::pair<double, double>> radial_snapshot(const Eigen::VectorXd& u) const {
@@ -175,8 +171,8 @@ std::unique_ptr<RunObserver> RingSpec::observer(const SceneDesc& scene, const Bu
 QoiKind ring_expansion_qoi() {
   return {"ring_expansion", [](ConfigMap& q, SceneReader& r) {
             for (const auto& other : r.scene.qois)
-              if (dynamic_cast<const RingSpec*>(other.get()))
-                q.fail("type", "one ring_expansion QoI per scene (its summary keys have no prefix)");
+              if (other->unprefixed())
+                q.fail("type", fmt::format("ring_expansion writes summary keys without prefix, as '{}' does: one such QoI per scene", other->name));
             auto s = std::make_shared<RingSpec>();
             const BodyDesc& b = r.body(q, "body", true, "ring_expansion");
             s->body = b.name;

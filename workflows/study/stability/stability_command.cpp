@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "pipeline/child_process.hpp"
 #include "workflows/study/stability/stability_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -24,12 +25,13 @@ constexpr const char* kUsage =
     "  --cases      only these case ids\n"
     "  --binary     the stentsim executable the cases run (default: this one)\n";
 
+/// This executable, or empty when unknown (the suite search then starts at the working folder).
 fs::path self_executable() {
-  char buf[4096];
-  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return {};
-  buf[n] = 0;
-  return fs::path(buf);
+  try {
+    return pipeline::self_executable();
+  } catch (const ComputeError&) {
+    return {};
+  }
 }
 
 fs::path default_suite() {
