@@ -45,7 +45,7 @@ MeshData generic_artery_mesh(const GenericArterySpec& s) {
       for (int i = 0; i < nt; ++i) {
         const double th = 2 * std::numbers::pi * i / nt;
         const double r = radius[static_cast<std::size_t>(k)];
-        m.points.emplace_back(r * std::cos(th), r * std::sin(th), s.length * j / nz);
+        m.points.emplace_back(r * std::cos(th), r * std::sin(th), s.length * (static_cast<double>(j) / nz - 0.5));
       }
   std::vector<double> layer, face;
   // Hex8 in VTK order: the bottom face (z_j) runs +r then +theta, so its

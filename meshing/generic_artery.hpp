@@ -1,6 +1,7 @@
 #pragma once
 // The generic artery of paper Case 1 (Section 4.1; DESIGN.md §5): a straight
-// tube along +z, media inside adventitia, meshed with structured trilinear hex8.
+// tube along +z, centred at the origin like the straight device (z from
+// −length/2 to length/2), media inside adventitia, meshed with structured trilinear hex8.
 #include "common/mesh_data.hpp"
 #include "common/summary.hpp"
 

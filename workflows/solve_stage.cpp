@@ -18,20 +18,50 @@ namespace stentsim::workflows {
 namespace fs = std::filesystem;
 namespace {
 
-std::string free_expansion_scene(const CaseConfig& c, const std::string& balloon, const std::string& stent) {
-  const SimulationSettings& s = c.simulation;
-  const double T = s.phase_duration, dt = T / s.load_steps;
-  std::ostringstream y;
-  y << fmt::format(
+/// Where the scene reads the earlier stages' artifacts.
+struct Artifacts {
+  std::string balloon, stent, artery, fibers;
+};
+
+/// The load phases (DESIGN.md §5): with an artery a prestress phase first
+/// (85 mmHg on the endothelium, held to the end); then inflation of the balloon
+/// to p_max and deflation, each one phase long. "prestress", "max" and
+/// "after" are the ends of the phases.
+struct Phases {
+  bool artery;
+  double T;
+  double prestress() const { return artery ? T : 0.0; }
+  double max() const { return prestress() + T; }
+  double after() const { return prestress() + 2 * T; }
+  std::string times() const {
+    return artery ? fmt::format("{{prestress: {:.17g}, max: {:.17g}, after: {:.17g}}}", prestress(), max(), after())
+                  : fmt::format("{{max: {:.17g}, after: {:.17g}}}", max(), after());
+  }
+};
+
+std::string selector(int face_group) { return fmt::format("{{cell_array: {{name: FaceGroup, value: {}}}}}", face_group); }
+
+std::string header(const CaseConfig& c, const Phases& ph) {
+  return fmt::format(
       "# Written by the solve stage of the case {case} (scene {scene}). Re-run by hand:\n"
       "#   stentsim solve scene.yaml --out DIR\n"
-      "# Free expansion (paper 3.1, DESIGN.md §3, §5): balloon + stent, stent–balloon beam-to-surface\n"
-      "# contact, balloon ends on Robin springs, the stent's fixation nodes; inflation to p_max over\n"
-      "# one phase, deflation over the next (\"max\" = t {T:g}, \"after\" = t {T2:g}).\n"
-      "description: free expansion of '{name}', p_max {p:g} MPa\n\n",
-      fmt::arg("case", c.file.string()), fmt::arg("scene", to_string(c.scene)), fmt::arg("T", T),
-      fmt::arg("T2", 2 * T), fmt::arg("name", c.name), fmt::arg("p", s.pressure_max));
-  y << fmt::format(
+      "# {what}\n"
+      "# Phases (DESIGN.md §5): {phases}.\n"
+      "description: {scene} '{name}', p_max {p:g} MPa\n\n",
+      fmt::arg("case", c.file.string()), fmt::arg("scene", to_string(c.scene)), fmt::arg("name", c.name),
+      fmt::arg("p", c.simulation.pressure_max),
+      fmt::arg("what", ph.artery ? "Generic artery (paper 4.1): artery (media, adventitia) with fibers, balloon, stent; "
+                                   "stent–balloon and stent–artery beam-to-surface, balloon–artery surface-to-surface contact."
+                                 : "Free expansion (paper 3.1): balloon + stent, stent–balloon beam-to-surface contact."),
+      fmt::arg("phases", ph.artery ? fmt::format("prestress to t {:g} (85 mmHg held), inflation to t {:g} (\"max\"), "
+                                                 "deflation to t {:g} (\"after\")",
+                                                 ph.prestress(), ph.max(), ph.after())
+                                   : fmt::format("inflation to t {:g} (\"max\"), deflation to t {:g} (\"after\")", ph.max(),
+                                                 ph.after())));
+}
+
+std::string bodies(const CaseConfig& c, const Artifacts& a, const Phases& ph) {
+  std::string y = fmt::format(
       "bodies:\n"
       "  - name: balloon\n"
       "    mesh: {{file: {b}}}\n"
@@ -40,83 +70,161 @@ std::string free_expansion_scene(const CaseConfig& c, const std::string& balloon
       "    fiber_frames:                # the straight balloon's axis: frames exact at every Gauss point\n"
       "      cylindrical: {{origin: [0, 0, 0], axis: [0, 0, 1]}}\n"
       "  - name: stent\n"
-      "    beam: {{file: {st}, material: stent, joints: rigid}}   # App. C elasto-plastic beams\n\n",
-      fmt::arg("b", balloon), fmt::arg("st", stent));
-  y << fmt::format("load_curves:\n  inflation: [[0, 0], [{:.17g}, 1], [{:.17g}, 0]]\n\n", T, 2 * T);
-  y << fmt::format(
+      "    beam: {{file: {st}, material: stent, joints: rigid}}   # App. C elasto-plastic beams\n",
+      fmt::arg("b", a.balloon), fmt::arg("st", a.stent));
+  if (ph.artery) {
+    const std::string tension = c.fibers.tension_only ? ", tension_only_fibers: true" : "";
+    y += fmt::format(
+        "  - name: artery\n"
+        "    mesh: {{file: {art}}}\n"
+        "    material_array: Layer\n"
+        "    materials:                   # App. B: coupled neo-Hooke + two fiber families + viscous branch\n"
+        "      - {{tag: {media}, preset: media{t}}}\n"
+        "      - {{tag: {adv}, preset: adventitia{t}}}\n"
+        "    fiber_frames: {{file: {fib}}}   # the fibers stage's frames and Fiber1, Fiber2\n",
+        fmt::arg("art", a.artery), fmt::arg("fib", a.fibers), fmt::arg("media", static_cast<int>(tags::media)),
+        fmt::arg("adv", static_cast<int>(tags::adventitia)), fmt::arg("t", tension));
+  }
+  return y + "\n";
+}
+
+std::string load_curves(const Phases& ph) {
+  std::string y = "load_curves:\n";
+  if (ph.artery)
+    y += fmt::format("  prestress: [[0, 0], [{:.17g}, 1], [{:.17g}, 1]]\n", ph.prestress(), ph.after()) +
+         fmt::format("  inflation: [[0, 0], [{:.17g}, 0], [{:.17g}, 1], [{:.17g}, 0]]\n", ph.prestress(), ph.max(), ph.after());
+  else
+    y += fmt::format("  inflation: [[0, 0], [{:.17g}, 1], [{:.17g}, 0]]\n", ph.max(), ph.after());
+  return y + "\n";
+}
+
+std::string springs(const std::string& name, const std::string& body, int group, double k) {
+  return fmt::format(
+      "  - name: {}\n    type: springs\n    body: {}\n    surface: {}\n    stiffness: {:.17g} N/mm^3\n", name, body,
+      selector(group), k);
+}
+
+std::string conditions(const CaseConfig& c, const Phases& ph) {
+  const SimulationSettings& s = c.simulation;
+  std::string y = fmt::format(
       "conditions:\n"
       "  - name: inflation\n"
       "    type: pressure\n"
       "    body: balloon\n"
-      "    surface: {{cell_array: {{name: FaceGroup, value: {inner}}}}}   # inner face\n"
-      "    value: {p:.17g} MPa\n"
-      "    curve: inflation\n"
-      "  - name: balloon_end_proximal\n"
-      "    type: springs\n"
-      "    body: balloon\n"
-      "    surface: {{cell_array: {{name: FaceGroup, value: {prox}}}}}\n"
-      "    stiffness: {k:.17g} N/mm^3\n"
-      "  - name: balloon_end_distal\n"
-      "    type: springs\n"
-      "    body: balloon\n"
-      "    surface: {{cell_array: {{name: FaceGroup, value: {dist}}}}}\n"
-      "    stiffness: {k:.17g} N/mm^3\n"
-      "  - name: stent_fixations\n"
-      "    type: direction                # radial fixation nodes move only radially, the axial one keeps d·u = 0\n"
-      "    body: stent\n"
-      "    node: fixations\n"
-      "    direction: file\n\n",
-      fmt::arg("inner", static_cast<int>(tags::balloon_inner)), fmt::arg("prox", static_cast<int>(tags::balloon_end_proximal)),
-      fmt::arg("dist", static_cast<int>(tags::balloon_end_distal)), fmt::arg("p", s.pressure_max),
-      fmt::arg("k", s.balloon_end_springs));
-  y << fmt::format(
-      "contact:\n"
-      "  - name: stent_balloon\n"
-      "    type: beam_to_surface\n"
-      "    beam: stent\n"
-      "    solid: balloon\n"
-      "    surface: {{cell_array: {{name: FaceGroup, value: {outer}}}}}   # outer face\n"
-      "    penalty: {eps:.17g} N/mm^2\n"
-      "    times: {{max: {T:.17g}, after: {T2:.17g}}}\n\n",
-      fmt::arg("outer", static_cast<int>(tags::balloon_outer)), fmt::arg("eps", s.beam_penalty), fmt::arg("T", T),
-      fmt::arg("T2", 2 * T));
-  y << fmt::format(
+      "    surface: {}   # inner face\n"
+      "    value: {:.17g} MPa\n"
+      "    curve: inflation\n",
+      selector(tags::balloon_inner), s.pressure_max);
+  y += springs("balloon_end_proximal", "balloon", tags::balloon_end_proximal, s.balloon_end_springs);
+  y += springs("balloon_end_distal", "balloon", tags::balloon_end_distal, s.balloon_end_springs);
+  y += "  - name: stent_fixations\n"
+       "    type: direction                # radial fixation nodes move only radially, the axial one keeps d·u = 0\n"
+       "    body: stent\n"
+       "    node: fixations\n"
+       "    direction: file\n";
+  if (ph.artery) {
+    y += fmt::format(
+        "  - name: diastolic\n"
+        "    type: pressure                 # follower load, Nanson's formula (DESIGN.md §5)\n"
+        "    body: artery\n"
+        "    surface: {}   # endothelium\n"
+        "    value: {:.17g} MPa\n"
+        "    curve: prestress\n",
+        selector(tags::endothelium), s.diastolic_pressure);
+    y += springs("cut_proximal", "artery", tags::proximal_cut, s.cut_springs);
+    y += springs("cut_distal", "artery", tags::distal_cut, s.cut_springs);
+  }
+  return y + "\n";
+}
+
+std::string beam_pair(const std::string& name, const std::string& solid, int group, double eps, const Phases& ph) {
+  return fmt::format(
+      "  - name: {}\n    type: beam_to_surface\n    beam: stent\n    solid: {}\n    surface: {}\n"
+      "    penalty: {:.17g} N/mm^2\n    times: {}\n",
+      name, solid, selector(group), eps, ph.times());
+}
+
+std::string contact(const CaseConfig& c, const Phases& ph) {
+  const SimulationSettings& s = c.simulation;
+  std::string y = "contact:\n" + beam_pair("stent_balloon", "balloon", tags::balloon_outer, s.beam_penalty, ph);
+  if (ph.artery) {
+    y += beam_pair("stent_artery", "artery", tags::endothelium, s.beam_penalty, ph);
+    y += fmt::format(
+        "  - name: balloon_artery\n"
+        "    type: surface_to_surface       # the balloon (finer) is the slave (DESIGN.md §8)\n"
+        "    slave: {{body: balloon, surface: {}}}\n"
+        "    master: {{body: artery, surface: {}}}\n"
+        "    penalty: {:.17g} N/mm^3\n"
+        "    times: {}\n",
+        selector(tags::balloon_outer), selector(tags::endothelium), s.surface_penalty, ph.times());
+  }
+  return y + "\n";
+}
+
+std::string solver_section(const CaseConfig& c, const Phases& ph) {
+  const double dt = ph.T / c.simulation.load_steps;
+  return fmt::format(
       "solver:\n"
-      "  time: {{start: 0, end: {T2:.17g}, dt: {dt:.17g}, dt_max: {dt:.17g}, dt_min: {dtmin:.17g}}}\n"
+      "  time: {{start: 0, end: {end:.17g}, dt: {dt:.17g}, dt_max: {dt:.17g}, dt_min: {dtmin:.17g}}}\n"
       "  newton: {{max_iterations: 25, residual_tolerance: 1.0e-8, increment_tolerance: 1.0e-8}}\n"
       "  linear: {{type: {lin}}}\n\n"
       "output:\n  every: {every}\n\n",
-      fmt::arg("T2", 2 * T), fmt::arg("dt", dt), fmt::arg("dtmin", dt * 1e-4),
-      fmt::arg("lin", solver::linear_solver_name(s.linear_solver)), fmt::arg("every", c.output.every));
+      fmt::arg("end", ph.after()), fmt::arg("dt", dt), fmt::arg("dtmin", dt * 1e-4),
+      fmt::arg("lin", solver::linear_solver_name(c.simulation.linear_solver)), fmt::arg("every", c.output.every));
+}
+
+std::string qois(const CaseConfig& c, const Phases& ph) {
   // Balloon profiles at fractions of p_max on the way up (the paper's balloon figure).
   std::string fractions;
-  for (double f : {0.2, 0.4, 0.6, 0.8, 1.0}) fractions += fmt::format("{}{:.6g}", fractions.empty() ? "" : ", ", f * s.pressure_max);
-  y << fmt::format(
+  for (double f : {0.2, 0.4, 0.6, 0.8, 1.0})
+    fractions += fmt::format("{}{:.6g}", fractions.empty() ? "" : ", ", f * c.simulation.pressure_max);
+  std::string y = fmt::format(
       "qoi:\n"
       "  - name: stent\n"
       "    type: stent_expansion          # ring diameters, recoil, dogboning (DESIGN.md §8), centroid curvature\n"
       "    body: stent\n"
       "    pressure: inflation\n"
-      "    times: {{max: {T:.17g}, after: {T2:.17g}}}\n"
+      "    times: {times}\n"
       "  - name: balloon\n"
       "    type: balloon_profile          # outer diameter along the (straight) axis\n"
       "    body: balloon\n"
-      "    surface: {{cell_array: {{name: FaceGroup, value: {outer}}}}}\n"
+      "    surface: {outer}\n"
       "    axis: {{origin: [0, 0, 0], direction: [0, 0, 1]}}\n"
       "    pressure: inflation\n"
       "    pressures: [{fr}]          # MPa\n"
-      "    times: {{max: {T:.17g}, after: {T2:.17g}}}\n",
-      fmt::arg("T", T), fmt::arg("T2", 2 * T), fmt::arg("outer", static_cast<int>(tags::balloon_outer)),
-      fmt::arg("fr", fractions));
-  return y.str();
+      "    times: {times}\n",
+      fmt::arg("times", ph.times()), fmt::arg("outer", selector(tags::balloon_outer)), fmt::arg("fr", fractions));
+  if (ph.artery)
+    y += fmt::format(
+        "  - name: artery\n"
+        "    type: layer_stresses           # max principal Cauchy stress per layer: Gauss-point maximum and nodal-averaged\n"
+        "    body: artery\n"
+        "    layer_array: Layer\n"
+        "    layers: {{media: {media}, adventitia: {adv}}}\n"
+        "    endothelium: {endo}\n"
+        "    times: {times}\n",
+        fmt::arg("media", static_cast<int>(tags::media)), fmt::arg("adv", static_cast<int>(tags::adventitia)),
+        fmt::arg("endo", selector(tags::endothelium)), fmt::arg("times", ph.times()));
+  return y;
 }
 
-/// The scene text with the artifacts' paths given as `balloon`, `stent`.
-std::string scene_text(const CaseConfig& c, const std::string& balloon, const std::string& stent) {
-  if (c.scene != Scene::free_expansion)
-    throw InputError(fmt::format("{}: scene '{}': this version builds the solve stage for free-expansion scenes only",
-                                 c.file.string(), to_string(c.scene)));
-  return free_expansion_scene(c, balloon, stent);
+/// The scene text with the artifacts' paths as given.
+std::string scene_text(const CaseConfig& c, const Artifacts& a) {
+  if (c.scene == Scene::patient)
+    throw InputError(fmt::format("{}: scene 'patient': this version builds the solve stage for free-expansion and "
+                                 "generic-artery scenes only",
+                                 c.file.string()));
+  const Phases ph{c.scene == Scene::generic_artery, c.simulation.phase_duration};
+  return header(c, ph) + bodies(c, a, ph) + load_curves(ph) + conditions(c, ph) + contact(c, ph) + solver_section(c, ph) +
+         qois(c, ph);
+}
+
+/// The artifacts, as paths relative to `dir` (the work folder's solve/) or absolute under `work`.
+Artifacts artifacts(const CaseConfig& c, const fs::path& work) {
+  auto at = [&](const char* rel) { return work.empty() ? std::string("../") + rel : (work / rel).string(); };
+  Artifacts a{at("balloon/balloon.vtu"), at("stent/stent.vtu"), "", ""};
+  if (c.scene != Scene::free_expansion) a.artery = at("mesh/artery.vtu"), a.fibers = at("fibers/fibers.vtu");
+  return a;
 }
 
 /// `mpirun` over `ranks` (or $STENTSIM_MPI_LAUNCH, e.g. inside a Slurm task).
@@ -132,16 +240,15 @@ std::vector<std::string> mpi_launcher(int ranks) {
 
 }  // namespace
 
-bool solve_stage_available(const CaseConfig& c) { return c.scene == Scene::free_expansion; }
+bool solve_stage_available(const CaseConfig& c) { return c.scene != Scene::patient; }
 
-std::string solve_scene_text(const CaseConfig& c) {
-  return scene_text(c, "../balloon/balloon.vtu", "../stent/stent.vtu");
-}
+std::string solve_scene_text(const CaseConfig& c) { return scene_text(c, artifacts(c, {})); }
 
 pipeline::Stage solve_stage(const CaseConfig& c) {
   pipeline::Stage s;
   s.name = "solve";
   s.inputs = {"balloon/balloon.vtu", "stent/stent.vtu"};
+  if (c.scene != Scene::free_expansion) s.inputs.insert(s.inputs.end(), {"mesh/artery.vtu", "fibers/fibers.vtu"});
   s.outputs = {"solve/scene.yaml", "solve/results.pvd", "solve/results/", "solve/history.csv"};
   s.version = "1";
   const std::string text = solve_scene_text(c);  // input errors before anything runs
@@ -166,8 +273,7 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
     }
     // MPI: a copy of the scene with absolute paths, run by `stentsim solve` under mpirun.
     const fs::path run_scene = out_dir.parent_path() / "run_scene.yaml";
-    files::write_atomic(run_scene, scene_text(cfg, (ctx.work_dir() / "balloon" / "balloon.vtu").string(),
-                                            (ctx.work_dir() / "stent" / "stent.vtu").string()));
+    files::write_atomic(run_scene, scene_text(cfg, artifacts(cfg, ctx.work_dir())));
     std::vector<std::string> argv = mpi_launcher(cfg.simulation.ranks);
     for (const std::string& a : {pipeline::self_executable().string(), std::string("solve"), run_scene.string(),
                                 std::string("--out"), out_dir.string()})

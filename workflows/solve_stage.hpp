@@ -18,7 +18,8 @@ bool solve_stage_available(const CaseConfig& c);
 /// The scene text, with paths relative to the work folder's solve/ (where it is written).
 std::string solve_scene_text(const CaseConfig& c);
 
-/// The stage: inputs balloon/balloon.vtu, stent/stent.vtu; outputs solve/scene.yaml,
+/// The stage: inputs balloon/balloon.vtu, stent/stent.vtu (with an artery also mesh/artery.vtu,
+/// fibers/fibers.vtu); outputs solve/scene.yaml,
 /// solve/results.pvd, solve/results/, solve/history.csv (and solve/summary.yaml).
 pipeline::Stage solve_stage(const CaseConfig& c);
 

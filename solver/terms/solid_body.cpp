@@ -1,5 +1,10 @@
 #include "solver/terms/solid_body.hpp"
 
+#include <Eigen/Eigenvalues>
+
+#include <array>
+#include <limits>
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -173,7 +178,8 @@ void SolidBody::load_history(const HistoryArchive& in, const std::string& prefix
 }
 
 template <class E>
-void SolidBody::cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& cauchy, Mat3& strain) const {
+void SolidBody::cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& cauchy, Mat3& strain,
+                             double& max_principal) const {
   using K = SolidElement<E>;
   typename K::NodeMat xr, xc;
   const std::int64_t* conn = &mesh_.connectivity[static_cast<std::size_t>(mesh_.cell_offsets[el.cell])];
@@ -184,20 +190,27 @@ void SolidBody::cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& 
   }
   const ViscousHistory* hist = el.history >= 0 ? &committed_[static_cast<std::size_t>(el.history)] : nullptr;
   double volume = 0.0;
+  std::array<Mat3, K::kPoints> points;
   const auto res = K::averages(xr, xc, materials_[static_cast<std::size_t>(el.material)], fiber_dirs_[el.cell].data(),
-                               hist, cauchy, strain, volume);
+                               hist, cauchy, strain, volume, points.data());
   if (!res.status.ok) fail(el, E::kName, res.point, res.status.why);
+  max_principal = -std::numeric_limits<double>::infinity();
+  for (const Mat3& sigma : points)
+    max_principal = std::max(max_principal, Eigen::SelfAdjointEigenSolver<Mat3>(sigma, Eigen::EigenvaluesOnly).eigenvalues()[2]);
 }
 
 SolidCellFields SolidBody::cell_fields(const Eigen::VectorXd& u) const {
   SolidCellFields out;
   out.cauchy.assign(mesh_.num_cells(), Mat3::Zero());
   out.strain.assign(mesh_.num_cells(), Mat3::Zero());
+  out.max_principal_gauss.assign(mesh_.num_cells(), 0.0);
   for (const Element& el : elements_) {
+    Mat3 &c = out.cauchy[el.cell], &e = out.strain[el.cell];
+    double& m = out.max_principal_gauss[el.cell];
     switch (mesh_.cell_types[el.cell]) {
-      case CellType::hexahedron: cell_average<fem::Hex8>(el, u, out.cauchy[el.cell], out.strain[el.cell]); break;
-      case CellType::tetra: cell_average<fem::Tet4>(el, u, out.cauchy[el.cell], out.strain[el.cell]); break;
-      case CellType::quadratic_tetra: cell_average<fem::Tet10>(el, u, out.cauchy[el.cell], out.strain[el.cell]); break;
+      case CellType::hexahedron: cell_average<fem::Hex8>(el, u, c, e, m); break;
+      case CellType::tetra: cell_average<fem::Tet4>(el, u, c, e, m); break;
+      case CellType::quadratic_tetra: cell_average<fem::Tet10>(el, u, c, e, m); break;
       default: break;
     }
   }

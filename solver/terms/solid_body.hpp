@@ -34,6 +34,9 @@ struct SolidBodySpec {
 struct SolidCellFields {
   std::vector<Mat3> cauchy;  // volume mean over the cell
   std::vector<Mat3> strain;  // Green-Lagrange, volume mean
+  /// Largest first principal Cauchy stress over the cell's quadrature points
+  /// (the Gauss-point maximum, DESIGN.md §6); 0 for cells without an element.
+  std::vector<double> max_principal_gauss;
 };
 
 class SolidBody : public Term {
@@ -77,7 +80,7 @@ class SolidBody : public Term {
   template <class E>
   void assemble_element(const Element& el, const SystemState& state, Assembler& out, bool tangent);
   template <class E>
-  void cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& cauchy, Mat3& strain) const;
+  void cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& cauchy, Mat3& strain, double& max_principal) const;
   [[noreturn]] void fail(const Element& el, const char* type, int point, const char* why) const;
 
   std::string name_;

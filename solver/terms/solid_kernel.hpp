@@ -90,9 +90,11 @@ struct SolidElement {
     return {PointStatus::good(), -1};
   }
 
-  /// Volume-weighted means of Cauchy stress and Green-Lagrange strain (output).
+  /// Volume-weighted means of Cauchy stress and Green-Lagrange strain (output);
+  /// `point_cauchy` (optional, kPoints entries) receives the Cauchy stress at each quadrature point.
   static Outcome averages(const NodeMat& x_ref, const NodeMat& x_cur, const Material& mat, const Vec3* fiber_dirs,
-                          const ViscousHistory* history, Mat3& cauchy, Mat3& strain, double& volume) {
+                          const ViscousHistory* history, Mat3& cauchy, Mat3& strain, double& volume,
+                          Mat3* point_cauchy = nullptr) {
     cauchy.setZero();
     strain.setZero();
     volume = 0.0;
@@ -108,7 +110,9 @@ struct SolidElement {
       if (!(f.determinant() > 0.0)) return {PointStatus::fail("J = det F <= 0 (inverted element)"), q};
       if (auto st = mat.elastic(f.transpose() * f, fiber_dirs, s, nullptr); !st.ok) return {st, q};
       if (mat.viscous && history) s += history[q].q;  // committed state: Q of the output step
-      cauchy += w * cauchy_from_pk2(f, from_voigt_stress(s));
+      const Mat3 sigma = cauchy_from_pk2(f, from_voigt_stress(s));
+      if (point_cauchy) point_cauchy[q] = sigma;
+      cauchy += w * sigma;
       strain += w * fem::green_lagrange(f);
       volume += w;
     }

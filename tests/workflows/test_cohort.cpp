@@ -102,7 +102,7 @@ TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
       "  - id: coarse\n    overrides: {mesh: {generic: {elements_around: 16, elements_along: 4}}}\n"
       "  - id: fine\n    overrides: {mesh: {generic: {elements_around: 24, elements_along: 6}}}\n"
       "  - id: other\n    overrides: {mesh: {generic: {elements_around: 20, elements_along: 5}}}\n");
-  auto r = sh("cohort run " + f);
+  auto r = sh("cohort run " + f + " --until fibers");  // the solve of a generic artery takes minutes
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << r.out;
   const auto csv = read_text(dir / "cohort.work/cohort_summary.csv");
@@ -120,7 +120,7 @@ TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
   EXPECT_FALSE(fs::exists(dir / "cohort.work/plot_override.mesh.generic.elements_around.png"));
   EXPECT_TRUE(fs::exists(dir / "cohort.work/plot_mesh.artery_elements.png"));
   // Second run: every case's stages are up to date.
-  r = sh("cohort run " + f);
+  r = sh("cohort run " + f + " --until fibers");
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* id : {"coarse", "fine", "other"}) {
     const auto log = read_text(dir / "cohort.work" / id / "run.log");
@@ -221,7 +221,7 @@ TEST_F(Cohort, SelectsCasesAndPassesRunnerOptions) {
 TEST_F(Cohort, UnexpectedOutcomeExitsOne) {
   // A case declared to fail at `mesh` that succeeds is reported and counted.
   const auto f = cohort("  - id: ok\n  - id: odd\n    expect_failure: mesh\n");
-  auto r = sh("cohort run " + f);
+  auto r = sh("cohort run " + f + " --until fibers");
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("odd: succeeded unexpectedly"), std::string::npos) << r.out;
   EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.csv").find("\"odd\",\"succeeded unexpectedly\",\"0\""), std::string::npos);
@@ -233,7 +233,7 @@ TEST_F(Cohort, ExpectedFailureStageNotRunIsDone) {
   auto r = sh("cohort run " + f + " --until mesh");
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(read_text(dir / "cohort.work/cohort_summary.csv").find("\"odd\",\"done\""), std::string::npos);
-  r = sh("cohort run " + f);  // now fibers runs and succeeds
+  r = sh("cohort run " + f + " --until fibers");  // now fibers runs and succeeds
   EXPECT_EQ(r.code, 1) << r.out;
 }
 

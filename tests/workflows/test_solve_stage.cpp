@@ -8,11 +8,14 @@
 #include <string>
 
 #include "common/files.hpp"
+#include "common/mesh_data.hpp"
 #include "common/summary.hpp"
 #include "solver/app/built_model.hpp"
 #include "solver/io/scene.hpp"
 #include "solver/io/scene_kinds.hpp"
 #include "tests/workflows/cli_runner.hpp"
+#include "workflows/case_config.hpp"
+#include "workflows/solve_stage.hpp"
 
 namespace fs = std::filesystem;
 using stentsim::Summary;
@@ -93,6 +96,53 @@ TEST_F(SolveStage, FreeExpansionRunsThroughSolveWithOnlyTheDevice) {
   EXPECT_NE(r.out.find("run   solve"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("run   balloon"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("run   stent"), std::string::npos) << r.out;
+}
+
+TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs) {
+  stentsim::files::write_atomic(dir / "ga.yaml",
+                                "name: ga-small\nscene: generic-artery\n"
+                                "device: {balloon: {length: 3 mm}, stent: {rings: 1}}\n"
+                                "mesh: {generic: {length: 5 mm, elements_around: 24, elements_along: 10, elements_media: 1, "
+                                "elements_adventitia: 1}}\n"
+                                "simulation: {load_steps: 4}\n");
+  for (const char* until : {"fibers", "balloon", "stent"}) {
+    const auto r = run_stentsim("run " + (dir / "ga.yaml").string() + " --until " + until);
+    ASSERT_EQ(r.code, 0) << r.out;
+  }
+  // The device and the artery share the axis and the origin.
+  const auto artery = stentsim::read_vtu((dir / "ga.work/mesh/artery.vtu").string());
+  double zmin = 1e9, zmax = -1e9;
+  for (const auto& p : artery.points) zmin = std::min(zmin, p.z()), zmax = std::max(zmax, p.z());
+  EXPECT_NEAR(zmin, -2.5, 1e-12);
+  EXPECT_NEAR(zmax, 2.5, 1e-12);
+
+  const auto c = stentsim::workflows::load_case(dir / "ga.yaml");
+  const std::string text = stentsim::workflows::solve_scene_text(c);
+  const auto scene = stentsim::solver::read_scene(text, dir / "ga.work/solve/scene.yaml");
+  ASSERT_EQ(scene.bodies.size(), 3u);
+  EXPECT_EQ(scene.bodies[2].name, "artery");
+  EXPECT_EQ(scene.stepping.t_end, 3.0);  // prestress, inflation, deflation
+  ASSERT_EQ(scene.contacts.size(), 3u);
+  EXPECT_EQ(scene.contacts[1]->name, "stent_artery");
+  EXPECT_EQ(scene.contacts[2]->name, "balloon_artery");
+  const auto model = stentsim::solver::build_model(scene);
+  EXPECT_EQ(model->bodies.size(), 2u);
+  EXPECT_EQ(model->bodies.count("artery"), 1u);
+  // The diastolic pressure is on from the first phase to the end; the balloon's only in phases 2 and 3.
+  for (const auto& [name, p] : model->pressures) {
+    if (name == "diastolic") {
+      EXPECT_NEAR(p->pressure(1.0), c.simulation.diastolic_pressure, 1e-15);
+      EXPECT_NEAR(p->pressure(3.0), c.simulation.diastolic_pressure, 1e-15);
+    } else {
+      EXPECT_EQ(p->pressure(1.0), 0.0);
+      EXPECT_NEAR(p->pressure(2.0), c.simulation.pressure_max, 1e-15);
+      EXPECT_EQ(p->pressure(3.0), 0.0);
+    }
+  }
+  EXPECT_EQ(model->pressures.size(), 2u);
+  // A patient case has no solve stage in this version.
+  stentsim::files::write_atomic(dir / "p.yaml", "name: p\nscene: patient\ninput: {phantom: {preset: straight-healthy}}\n");
+  EXPECT_FALSE(stentsim::workflows::solve_stage_available(stentsim::workflows::load_case(dir / "p.yaml")));
 }
 
 }  // namespace

@@ -11,5 +11,6 @@ QoiKind tip_rotation_angle_qoi();
 QoiKind ring_expansion_qoi();
 QoiKind stent_expansion_qoi();
 QoiKind balloon_profile_qoi();
+QoiKind layer_stresses_qoi();
 
 }  // namespace stentsim::solver
