@@ -87,7 +87,7 @@ FiberSettings parse_fibers(ConfigMap m) {
 
 SimulationSettings parse_simulation(ConfigMap m) {
   SimulationSettings s;
-  s.pressure_max = m.quantity("pressure_max", units::kPressure, s.pressure_max, Range::between(0, 10));
+  s.pressure_max = m.quantity("pressure_max", units::kPressure, s.pressure_max, Range{0.0, 10.0, false, true});
   s.diastolic_pressure = m.quantity("diastolic_pressure", units::kPressure, s.diastolic_pressure, Range::between(0, 0.1));
   s.phase_duration = m.quantity("phase_duration", units::kTime, s.phase_duration, Range::positive());
   s.load_steps = m.integer("load_steps", s.load_steps, Range::between(1, 100000));

@@ -24,7 +24,7 @@ struct Artifacts {
 };
 
 /// The load phases (DESIGN.md §5): with an artery a prestress phase first
-/// (85 mmHg on the endothelium, held to the end); then inflation of the balloon
+/// (the diastolic pressure on the endothelium, held to the end); then inflation of the balloon
 /// to p_max and deflation, each one phase long. "prestress", "max" and
 /// "after" are the ends of the phases.
 struct Phases {
@@ -39,6 +39,16 @@ struct Phases {
   }
 };
 
+/// A YAML double-quoted scalar (names and paths may hold ':', '#', ',', '}').
+std::string quoted(const std::string& text) {
+  std::string q = "\"";
+  for (char ch : text) {
+    if (ch == '"' || ch == '\\') q += '\\';
+    q += ch;
+  }
+  return q + "\"";
+}
+
 std::string selector(int face_group) { return fmt::format("{{cell_array: {{name: FaceGroup, value: {}}}}}", face_group); }
 
 std::string header(const CaseConfig& c, const Phases& ph) {
@@ -47,13 +57,13 @@ std::string header(const CaseConfig& c, const Phases& ph) {
       "#   stentsim solve scene.yaml --out DIR\n"
       "# {what}\n"
       "# Phases (DESIGN.md §5): {phases}.\n"
-      "description: {scene} '{name}', p_max {p:g} MPa\n\n",
-      fmt::arg("case", c.file.string()), fmt::arg("scene", to_string(c.scene)), fmt::arg("name", c.name),
-      fmt::arg("p", c.simulation.pressure_max),
+      "description: {desc}\n\n",
+      fmt::arg("case", c.file.string()), fmt::arg("scene", to_string(c.scene)),
+      fmt::arg("desc", quoted(fmt::format("{} '{}', p_max {:g} MPa", to_string(c.scene), c.name, c.simulation.pressure_max))),
       fmt::arg("what", ph.artery ? "Generic artery (paper 4.1): artery (media, adventitia) with fibers, balloon, stent; "
                                    "stent–balloon and stent–artery beam-to-surface, balloon–artery surface-to-surface contact."
                                  : "Free expansion (paper 3.1): balloon + stent, stent–balloon beam-to-surface contact."),
-      fmt::arg("phases", ph.artery ? fmt::format("prestress to t {:g} (85 mmHg held), inflation to t {:g} (\"max\"), "
+      fmt::arg("phases", ph.artery ? fmt::format("prestress to t {:g} (diastolic pressure, held), inflation to t {:g} (\"max\"), "
                                                  "deflation to t {:g} (\"after\")",
                                                  ph.prestress(), ph.max(), ph.after())
                                    : fmt::format("inflation to t {:g} (\"max\"), deflation to t {:g} (\"after\")", ph.max(),
@@ -71,7 +81,7 @@ std::string bodies(const CaseConfig& c, const Artifacts& a, const Phases& ph) {
       "      cylindrical: {{origin: [0, 0, 0], axis: [0, 0, 1]}}\n"
       "  - name: stent\n"
       "    beam: {{file: {st}, material: stent, joints: rigid}}   # App. C elasto-plastic beams\n",
-      fmt::arg("b", a.balloon), fmt::arg("st", a.stent));
+      fmt::arg("b", quoted(a.balloon)), fmt::arg("st", quoted(a.stent)));
   if (ph.artery) {
     const std::string tension = c.fibers.tension_only ? ", tension_only_fibers: true" : "";
     y += fmt::format(
@@ -82,7 +92,7 @@ std::string bodies(const CaseConfig& c, const Artifacts& a, const Phases& ph) {
         "      - {{tag: {media}, preset: media{t}}}\n"
         "      - {{tag: {adv}, preset: adventitia{t}}}\n"
         "    fiber_frames: {{file: {fib}}}   # the fibers stage's frames and Fiber1, Fiber2\n",
-        fmt::arg("art", a.artery), fmt::arg("fib", a.fibers), fmt::arg("media", static_cast<int>(tags::media)),
+        fmt::arg("art", quoted(a.artery)), fmt::arg("fib", quoted(a.fibers)), fmt::arg("media", static_cast<int>(tags::media)),
         fmt::arg("adv", static_cast<int>(tags::adventitia)), fmt::arg("t", tension));
   }
   return y + "\n";
@@ -177,7 +187,7 @@ std::string qois(const CaseConfig& c, const Phases& ph) {
   // Balloon profiles at fractions of p_max on the way up (the paper's balloon figure).
   std::string fractions;
   for (double f : {0.2, 0.4, 0.6, 0.8, 1.0})
-    fractions += fmt::format("{}{:.6g}", fractions.empty() ? "" : ", ", f * c.simulation.pressure_max);
+    fractions += fmt::format("{}{:.17g}", fractions.empty() ? "" : ", ", f == 1.0 ? c.simulation.pressure_max : f * c.simulation.pressure_max);
   std::string y = fmt::format(
       "qoi:\n"
       "  - name: stent\n"
@@ -208,15 +218,24 @@ std::string qois(const CaseConfig& c, const Phases& ph) {
   return y;
 }
 
+Phases phases(const CaseConfig& c) { return {c.scene == Scene::generic_artery, c.simulation.phase_duration}; }
+
+/// The comments and description (the case's name and file: not physics).
+std::string scene_header(const CaseConfig& c) { return header(c, phases(c)); }
+
+/// Everything the solve computes from, with the artifacts' paths as given.
+std::string scene_body(const CaseConfig& c, const Artifacts& a) {
+  const Phases ph = phases(c);
+  return bodies(c, a, ph) + load_curves(ph) + conditions(c, ph) + contact(c, ph) + solver_section(c, ph) + qois(c, ph);
+}
+
 /// The scene text with the artifacts' paths as given.
 std::string scene_text(const CaseConfig& c, const Artifacts& a) {
   if (c.scene == Scene::patient)
     throw InputError(fmt::format("{}: scene 'patient': this version builds the solve stage for free-expansion and "
                                  "generic-artery scenes only",
                                  c.file.string()));
-  const Phases ph{c.scene == Scene::generic_artery, c.simulation.phase_duration};
-  return header(c, ph) + bodies(c, a, ph) + load_curves(ph) + conditions(c, ph) + contact(c, ph) + solver_section(c, ph) +
-         qois(c, ph);
+  return scene_header(c) + scene_body(c, a);
 }
 
 /// The artifacts, as paths relative to `dir` (the work folder's solve/) or absolute under `work`.
@@ -252,8 +271,9 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
   s.outputs = {"solve/scene.yaml", "solve/results.pvd", "solve/results/", "solve/history.csv"};
   s.version = "1";
   const std::string text = solve_scene_text(c);  // input errors before anything runs
-  // The scene is everything the solve depends on besides its input files.
-  s.config = text + fmt::format("ranks={};", c.simulation.ranks);
+  // The scene's body is everything the solve depends on besides its input
+  // files (not the case's name or folder; the rank count changes no result, DESIGN.md §7).
+  s.config = scene_body(c, artifacts(c, {}));
   const CaseConfig cfg = c;
   s.run = [text, cfg](pipeline::StageContext& ctx) {
     const fs::path scene_out = ctx.output("solve/scene.yaml");
@@ -282,7 +302,9 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
     const pid_t pid = pipeline::spawn_exec(argv);
     const pipeline::ChildEnd end = pipeline::wait_with_limit(pid, start, 1e9);
     if (!end.ok())
-      throw ComputeError(fmt::format("the MPI solve ({} ranks) ended with {}; see the log", cfg.simulation.ranks, end.describe()));
+      throw ComputeError(fmt::format("the MPI solve ({} ranks) ended with {} (the log says where and why); what it wrote "
+                                     "is kept in {}",
+                                     cfg.simulation.ranks, end.describe(), (ctx.work_dir() / "failed" / "solve").string()));
     ctx.summary() = Summary::read(out_dir / "summary.yaml");
   };
   return s;

@@ -116,7 +116,7 @@ Fixture make_fixture(const std::string& name, const FixtureOptions& o = {}) {
   // recoil_percent left out: not computed
   s.set("dogboning_percent", 21.0, "%");  // paper 20.4 +-5 abs: pass
   s.set("dogboning_pressure", 0.84, "MPa");
-  s.set("newton_iterations_total", 160, "");
+  s.set("newton_iterations", 160, "");
   s.set("steps", 40, "");
   if (o.balloon_profile) {
     s.set("balloon_profile_z", std::vector<double>{-4, -2, 0, 2, 4}, "mm");

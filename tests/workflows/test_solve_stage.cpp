@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <string>
 
@@ -56,7 +58,7 @@ TEST_F(SolveStage, FreeExpansionRunsThroughSolveWithOnlyTheDevice) {
 
   // The balloon pushes the crimped rings (1.15 mm) out; they spring back on deflation.
   const fs::path sum = work / "solve/summary.yaml";
-  EXPECT_NEAR(qoi(sum, "stent_diameter_initial"), 1.15, 0.02);  // mean over all strut nodes, not only the crowns
+  EXPECT_NEAR(qoi(sum, "stent_diameter_initial"), 1.15, 0.02);  // the strut elements' end nodes, on the crimped cylinder
   const double d_max = qoi(sum, "stent_diameter_max"), d_after = qoi(sum, "stent_diameter_after");
   EXPECT_GT(d_max, 1.3);
   EXPECT_LT(d_after, d_max);
@@ -65,6 +67,14 @@ TEST_F(SolveStage, FreeExpansionRunsThroughSolveWithOnlyTheDevice) {
   EXPECT_EQ(qoi(sum, "stent_rings"), 2);
   EXPECT_GT(qoi(sum, "contact_line_load_max_stent_balloon_max"), 0.0);
   EXPECT_EQ(Summary::read(sum).qois().count("balloon_profile_diameter_p0_6"), 1u);
+  EXPECT_EQ(Summary::read(sum).qois().count("dogboning_percent"), 0u);  // two rings: no middle ring
+
+  // The report shows the solve's numbers, not "not computed".
+  const std::string report = stentsim::files::read_text(work / "report/report.md");
+  EXPECT_NE(report.find("stent_diameter_max"), std::string::npos) << report;
+  EXPECT_NE(report.find(fmt::format("{:.4g}", d_max)), std::string::npos) << report;
+  EXPECT_TRUE(fs::exists(work / "report/report.html"));
+  EXPECT_TRUE(fs::exists(work / "report/figures/stent_diameter_vs_pressure.png"));
 
   // Only what the scene needs (DESIGN.md §3): the balloon and the stent, one beam-to-surface pair.
   const auto scene = stentsim::solver::read_scene(work / "solve/scene.yaml");

@@ -75,8 +75,8 @@ const std::vector<TargetMapping>& target_mappings() {
     {"patient_case2", "adventitia_after_kPa", {"max_principal_adventitia_after_kpa"}, "kPa", true, true, kPatient},
     {"patient_case2", "stent_bending_moment_max_Nmm", {"stent_bending_moment_max_max"}, "N mm", true, true, kPatient},
     {"patient_case2", "stent_bending_moment_after_max_Nmm", {"stent_bending_moment_max_after"}, "N mm", true, true, kPatient},
-    {"patient_case2", "contact_line_load_max_N_per_mm", {"contact_line_load_max_max"}, "N/mm", true, true, kPatient},
-    {"patient_case2", "contact_line_load_after_max_N_per_mm", {"contact_line_load_max_after"}, "N/mm", true, true, kPatient},
+    {"patient_case2", "contact_line_load_max_N_per_mm", {"contact_line_load_max_stent_artery_max"}, "N/mm", true, true, kPatient},
+    {"patient_case2", "contact_line_load_after_max_N_per_mm", {"contact_line_load_max_stent_artery_after"}, "N/mm", true, true, kPatient},
   };
   // clang-format on
   return table;

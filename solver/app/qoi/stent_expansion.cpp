@@ -8,7 +8,9 @@
 // judged by its maximum over the inflation (t ≤ the `max` time) and the
 // pressure of the named pressure condition where it occurs; its value at
 // 0.8·p_max (linear in pressure between the two steps around it) and the
-// /r_central variant are reported too. Summary keys carry no prefix (one
+// /r_central variant are reported too (three rings or more). The ring nodes
+// are the end nodes of the ring's strut elements (crowns and the nodes
+// between a strut's elements), on the strut centerlines. Summary keys carry no prefix (one
 // stent_expansion per scene; not with ring_expansion, whose recoil_percent it shares).
 #include <fmt/format.h>
 
@@ -66,7 +68,7 @@ class StentExpansion : public RunObserver {
 
   void start(const Eigen::VectorXd& u, bool restarted) override {
     now_ = measure(u);
-    if (!restarted) initial_ = now_, at_["initial"] = now_;
+    if (!restarted) at_["initial"] = now_;
   }
   void step(const StepRecord& r, const Eigen::VectorXd& u) override {
     now_ = measure(u);
@@ -110,7 +112,8 @@ class StentExpansion : public RunObserver {
     const auto mx = at_.find("max"), af = at_.find("after");
     if (mx != at_.end() && af != at_.end() && mx->second.diameter > 0)
       s.set("recoil_percent", 100.0 * (mx->second.diameter - af->second.diameter) / mx->second.diameter, "%");
-    if (series_.empty() || ring_nodes_.size() < 2) return;
+    // Dogboning compares end rings with a middle one: it needs three rings at least.
+    if (series_.empty() || ring_nodes_.size() < 3) return;
     auto peak = std::max_element(series_.begin(), series_.end(), [](const Sample& a, const Sample& b) { return a.distal < b.distal; });
     s.set("dogboning_percent", peak->distal, "%");
     s.set("dogboning_time", peak->time, "s");
@@ -118,10 +121,8 @@ class StentExpansion : public RunObserver {
     s.set("dogboning_central_percent", peak_c->central, "%");
     if (!pressure_) return;
     s.set("dogboning_pressure", peak->pressure, "MPa");
-    // 0.8·p_max: the first step pair of the inflation that brackets it.
-    double p_max = 0.0;
-    for (const auto& x : series_) p_max = std::max(p_max, x.pressure);
-    const double p08 = 0.8 * p_max;
+    // 0.8·p_max (p_max: the pressure at the `max` time): the first step pair of the inflation that brackets it.
+    const double p08 = 0.8 * pressure_->pressure(t_inflated_);
     double prev_p = 0.0, prev_d = 0.0;  // the undeformed stent: no dogboning at p = 0
     for (const auto& x : series_) {
       if (x.pressure >= p08 && x.pressure > prev_p) {
@@ -185,7 +186,7 @@ class StentExpansion : public RunObserver {
   const FollowerPressure* pressure_ = nullptr;
   double t_end_, t_inflated_;
   std::vector<std::vector<int>> ring_nodes_;
-  State initial_, now_;
+  State now_;
   std::map<std::string, State> at_;
   std::vector<Sample> series_;
 };
