@@ -3,12 +3,17 @@
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <limits>
 #include <fstream>
 #include <sstream>
 
+#include "common/config.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/log.hpp"
+#include "common/mesh_data.hpp"
 #include "common/mesh_tags.hpp"
+#include "device_gen/stent_design.hpp"
 #include "pipeline/child_process.hpp"
 #include "solver/app/solve.hpp"
 #include "solver/io/scene.hpp"
@@ -259,6 +264,32 @@ std::vector<std::string> mpi_launcher(int ranks) {
 
 }  // namespace
 
+std::string contact_face_size_warning(const fs::path& artery_vtu, double strut_diameter) {
+  const MeshData m = read_vtu(artery_vtu.string());
+  const auto groups = m.cell_data.find(tags::kFaceGroup);
+  if (groups == m.cell_data.end()) return {};  // the solver names the missing array
+  std::size_t faces = 0, small = 0;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    if (static_cast<int>(groups->second.at(c)) != tags::endothelium) continue;
+    const auto nodes = m.cell(c);
+    const std::size_t corners = m.cell_types[c] == CellType::quad ? 4 : 3;
+    double shortest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < corners && corners <= nodes.size(); ++i)
+      shortest = std::min(shortest, (m.points[nodes[i]] - m.points[nodes[(i + 1) % corners]]).norm());
+    ++faces;
+    if (shortest < strut_diameter) ++small;
+    smallest = std::min(smallest, shortest);
+  }
+  if (small == 0) return {};
+  const std::string msg = fmt::format(
+      "{} of {} endothelium faces of {} have an edge shorter than the strut diameter {:g} mm (shortest {:.3g} mm); "
+      "the paper keeps contact faces no smaller than the struts (2.5): coarsen the artery mesh where the stent lies",
+      small, faces, artery_vtu.string(), strut_diameter, smallest);
+  log::warn("{}", msg);
+  return msg;
+}
+
 bool solve_stage_available(const CaseConfig& c) { return c.scene != Scene::patient; }
 
 std::string solve_scene_text(const CaseConfig& c) { return scene_text(c, artifacts(c, {})); }
@@ -275,12 +306,17 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
   // files (not the case's name or folder; the rank count changes no result, DESIGN.md §7).
   s.config = scene_body(c, artifacts(c, {}));
   const CaseConfig cfg = c;
-  s.run = [text, cfg](pipeline::StageContext& ctx) {
+  ConfigMap stent(c.section("device.stent"), std::make_shared<const fs::path>(c.file), "device.stent");
+  const double strut_diameter = 2 * device_gen::parse_stent_design(stent).strut_radius;
+  s.run = [text, cfg, strut_diameter](pipeline::StageContext& ctx) {
     const fs::path scene_out = ctx.output("solve/scene.yaml");
     files::write_atomic(scene_out, text);
     const fs::path out_dir = scene_out.parent_path();
     // Read as the file it becomes (work/solve/scene.yaml), so its relative paths hold.
     const fs::path final_scene = ctx.work_dir() / "solve" / "scene.yaml";
+    const std::string face_warning =
+        cfg.scene == Scene::free_expansion ? "" : contact_face_size_warning(ctx.input("mesh/artery.vtu"), strut_diameter);
+    if (!face_warning.empty()) ctx.summary().note("warning_contact_face_size", face_warning);
     if (cfg.simulation.ranks <= 1) {
       const solver::SceneDesc scene = solver::read_scene(text, final_scene);
       solver::SolveOptions o;
@@ -306,6 +342,7 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
                                      "is kept in {}",
                                      cfg.simulation.ranks, end.describe(), (ctx.work_dir() / "failed" / "solve").string()));
     ctx.summary() = Summary::read(out_dir / "summary.yaml");
+    if (!face_warning.empty()) ctx.summary().note("warning_contact_face_size", face_warning);
   };
   return s;
 }

@@ -5,6 +5,7 @@
 // simulation.ranks > 1, as an MPI child process) and which a user re-runs by
 // hand with `stentsim solve solve/scene.yaml`. The case adds no physics the
 // scene format cannot express (DESIGN.md §8).
+#include <filesystem>
 #include <string>
 
 #include "pipeline/stage.hpp"
@@ -14,6 +15,11 @@ namespace stentsim::workflows {
 
 /// Does this version build the solve stage for the case's scene?
 bool solve_stage_available(const CaseConfig& c);
+
+/// DESIGN.md §8 (paper 2.5): the artery's contact faces should be no smaller
+/// than the strut diameter. Empty when they are; else the warning (also logged)
+/// naming the file, how many endothelium faces are smaller and the shortest edge.
+std::string contact_face_size_warning(const std::filesystem::path& artery_vtu, double strut_diameter);
 
 /// The scene text, with paths relative to the work folder's solve/ (where it is written).
 std::string solve_scene_text(const CaseConfig& c);
