@@ -691,3 +691,19 @@ TEST(Report, ChromiumRendersTheHtml) {
 }
 
 }  // namespace
+
+// The embedded copy of the paper's numbers is the shared validation file, word for word.
+TEST(ReportTargets, EmbeddedCopyMatchesTheSharedValidationFile) {
+  const char* shared = std::getenv("STENTSIM_SHARED_DIR");
+  if (!shared) GTEST_SKIP() << "no shared folder (../shared or /work/shared): nothing to compare with";
+  auto text = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  const std::string ours = text(fs::path(STENTSIM_TEST_SOURCE_DIR) / "workflows/report/paper_targets.yaml");
+  ASSERT_FALSE(ours.empty());
+  EXPECT_EQ(ours, text(fs::path(shared) / "validation/targets.yaml"))
+      << "workflows/report/paper_targets.yaml differs from the shared validation/targets.yaml: copy it again";
+}
