@@ -192,9 +192,9 @@ class BeamToSurfaceSpec : public ContactSpec {
                                                                        : std::string("linear law"),
                                         s.form == contact::BeamContactForm::potential ? "penalty potential" : "gap variation");
     log::info("contact '{}': beam '{}' on {} faces of '{}' ({}), penalty {:g} N/mm^2, {}, {} Gauss points per element, R = {:g} mm; "
-              "initially {} points within reach, smallest gap {:.4g} mm",
+              "initially {} points within reach{}",
               name, beam, faces.size(), solid, contact::face_kind_name(pair.surface().faces()[0].kind), s.law.epsilon, law,
-              s.gauss_points, s.radius, projected, projected ? min_gap : std::nan(""));
+              s.gauss_points, s.radius, projected, projected ? fmt::format(", smallest gap {:.4g} mm", min_gap) : std::string());
     m.notes.push_back(fmt::format("contact {}: beam-to-surface penalty, beam {} on {}, epsilon {:g} N/mm^2, {}, {} Gauss points per "
                                   "element, R {:g} mm, frictionless",
                                   name, beam, solid, s.law.epsilon, law, s.gauss_points, s.radius));
