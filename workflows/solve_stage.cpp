@@ -119,17 +119,17 @@ std::string springs(const std::string& name, const std::string& body, int group,
       selector(group), k);
 }
 
+std::string pressure(const std::string& name, const std::string& body, int group, double value, const std::string& curve,
+                     const std::string& what) {
+  return fmt::format("  - name: {}\n    type: pressure                 # {}\n    body: {}\n    surface: {}\n"
+                     "    value: {:.17g} MPa\n    curve: {}\n",
+                     name, what, body, selector(group), value, curve);
+}
+
 std::string conditions(const CaseConfig& c, const Phases& ph) {
   const SimulationSettings& s = c.simulation;
-  std::string y = fmt::format(
-      "conditions:\n"
-      "  - name: inflation\n"
-      "    type: pressure\n"
-      "    body: balloon\n"
-      "    surface: {}   # inner face\n"
-      "    value: {:.17g} MPa\n"
-      "    curve: inflation\n",
-      selector(tags::balloon_inner), s.pressure_max);
+  std::string y = "conditions:\n" + pressure("inflation", "balloon", tags::balloon_inner, s.pressure_max, "inflation",
+                                             "follower load on the balloon's inner face");
   y += springs("balloon_end_proximal", "balloon", tags::balloon_end_proximal, s.balloon_end_springs);
   y += springs("balloon_end_distal", "balloon", tags::balloon_end_distal, s.balloon_end_springs);
   y += "  - name: stent_fixations\n"
@@ -138,14 +138,8 @@ std::string conditions(const CaseConfig& c, const Phases& ph) {
        "    node: fixations\n"
        "    direction: file\n";
   if (ph.artery) {
-    y += fmt::format(
-        "  - name: diastolic\n"
-        "    type: pressure                 # follower load, Nanson's formula (DESIGN.md §5)\n"
-        "    body: artery\n"
-        "    surface: {}   # endothelium\n"
-        "    value: {:.17g} MPa\n"
-        "    curve: prestress\n",
-        selector(tags::endothelium), s.diastolic_pressure);
+    y += pressure("diastolic", "artery", tags::endothelium, s.diastolic_pressure, "prestress",
+                  "follower load on the endothelium, Nanson's formula (DESIGN.md §5)");
     y += springs("cut_proximal", "artery", tags::proximal_cut, s.cut_springs);
     y += springs("cut_distal", "artery", tags::distal_cut, s.cut_springs);
   }

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "common/files.hpp"
+#include "common/markdown.hpp"
 #include "workflows/plots/figure.hpp"
 
 namespace fs = std::filesystem;
@@ -62,15 +63,6 @@ std::string plot_file_name(const std::string& col) {
   return stem + ".png";
 }
 
-std::string md_escape(const std::string& s) {
-  std::string out;
-  for (char ch : s) {
-    if (ch == '|') out += "\\|";
-    else if (ch == '\n') out += ' ';
-    else out += ch;
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -169,13 +161,13 @@ void write_cohort_markdown(const CohortConfig& c, const CohortTable& t) {
                     n_ok, n_expected, n_failed);
 
   md += "## Cases\n\n| case | status | failed stage | wall time [s] |";
-  for (const auto& col : qois) md += " " + md_escape(col) + " |";
+  for (const auto& col : qois) md += " " + markdown_cell(col) + " |";
   md += "\n|---|---|---|---:|";
   for (std::size_t i = 0; i < qois.size(); ++i) md += "---:|";
   md += "\n";
   for (const auto& row : t.rows) {
-    md += fmt::format("| {} | {} | {} | {} |", md_escape(cell(row, "case")), md_escape(cell(row, "status")),
-                      md_escape(cell(row, "failed_stage")), cell(row, "wall_time_s"));
+    md += fmt::format("| {} | {} | {} | {} |", markdown_cell(cell(row, "case")), markdown_cell(cell(row, "status")),
+                      markdown_cell(cell(row, "failed_stage")), cell(row, "wall_time_s"));
     for (const auto& col : qois) {
       const auto v = number(cell(row, col));
       md += v ? fmt::format(" {:.4g} |", *v) : std::string(" – |");
@@ -192,8 +184,8 @@ void write_cohort_markdown(const CohortConfig& c, const CohortTable& t) {
     const double median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
     const QoiName q = split_column(col);
     const auto png = plot_file_name(col);
-    md += fmt::format("| {}.{} | {} | {} | {:.4g} | {:.4g} | {:.4g} | [{}]({}) |\n", md_escape(q.stage), md_escape(q.name),
-                      md_escape(q.unit), v.size(), v.front(), median, v.back(), png, png);
+    md += fmt::format("| {}.{} | {} | {} | {:.4g} | {:.4g} | {:.4g} | [{}]({}) |\n", markdown_cell(q.stage), markdown_cell(q.name),
+                      markdown_cell(q.unit), v.size(), v.front(), median, v.back(), png, png);
   }
 
   bool any_failure = false;
@@ -201,9 +193,9 @@ void write_cohort_markdown(const CohortConfig& c, const CohortTable& t) {
     if (!cell(row, "message").empty()) {
       if (!any_failure) md += "\n## Failures (last log lines)\n\n";
       any_failure = true;
-      md += fmt::format("- **{}** ({}{}): {}\n", md_escape(cell(row, "case")), cell(row, "status"),
+      md += fmt::format("- **{}** ({}{}): {}\n", markdown_cell(cell(row, "case")), cell(row, "status"),
                         cell(row, "failed_stage").empty() ? "" : " at " + cell(row, "failed_stage"),
-                        md_escape(cell(row, "message")));
+                        markdown_cell(cell(row, "message")));
     }
   files::write_atomic(c.work_dir / "cohort_summary.md", md);
 }

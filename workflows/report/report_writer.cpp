@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "common/files.hpp"
+#include "common/markdown.hpp"
 
 namespace stentsim::workflows::report {
 namespace {
@@ -44,15 +45,6 @@ std::string inline_html(const std::string& text) {
   return out;
 }
 
-std::string md_cell(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '|') out += "\\|";
-    else if (c == '\n') out += ' ';
-    else out += c;
-  }
-  return out;
-}
 
 std::string cell_class(const std::string& s) {
   if (s == "pass" || s.rfind("pass [", 0) == 0 || s == "ok") return " class=\"pass\"";
@@ -111,11 +103,11 @@ std::string Document::markdown() const {
         break;
       case Block::Kind::table: {
         std::string head = "|", rule = "|";
-        for (const auto& h : b.items) head += " " + md_cell(h) + " |", rule += "---|";
+        for (const auto& h : b.items) head += " " + markdown_cell(h) + " |", rule += "---|";
         out += head + "\n" + rule + "\n";
         for (const auto& r : b.rows) {
           std::string line = "|";
-          for (std::size_t i = 0; i < b.items.size(); ++i) line += " " + md_cell(i < r.size() ? r[i] : "") + " |";
+          for (std::size_t i = 0; i < b.items.size(); ++i) line += " " + markdown_cell(i < r.size() ? r[i] : "") + " |";
           out += line + "\n";
         }
         out += "\n";

@@ -17,6 +17,7 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/markdown.hpp"
 #include "common/summary.hpp"
 #include "common/mesh_data.hpp"
 #include "pipeline/manifest.hpp"
@@ -111,11 +112,6 @@ std::string csv_cell(const std::string& s) {
   return q + "\"";
 }
 
-std::string md_cell(const std::string& s) {
-  std::string out;
-  for (char ch : s) out += ch == '|' ? std::string("\\|") : std::string(1, ch == '\n' ? ' ' : ch);
-  return out;
-}
 
 std::string opt(const std::optional<double>& v) { return v ? fmt::format("{:g}", *v) : ""; }
 
@@ -434,9 +430,9 @@ void write_stability_tables(const StabilityReport& r, const fs::path& dir) {
   md += "| case | outcome | as expected | Newton iterations | step cuts | time (s) | limit (s) | message |\n";
   md += "|---|---|---|---:|---:|---:|---:|---|\n";
   for (const auto& o : r.cases)
-    md += fmt::format("| {} | {} | {} | {} | {} | {:.1f} | {:.0f} | {} |\n", md_cell(o.id), o.outcome,
-                      o.as_expected ? "yes" : "**no**: " + md_cell(o.check), opt(o.iterations), opt(o.cuts), o.run.wall_s,
-                      o.limit_s, md_cell(o.message));
+    md += fmt::format("| {} | {} | {} | {} | {} | {:.1f} | {:.0f} | {} |\n", markdown_cell(o.id), o.outcome,
+                      o.as_expected ? "yes" : "**no**: " + markdown_cell(o.check), opt(o.iterations), opt(o.cuts), o.run.wall_s,
+                      o.limit_s, markdown_cell(o.message));
   md += fmt::format("\n{} of {} case(s) as expected.\n", r.cases.size() - static_cast<std::size_t>(r.unexpected()), r.cases.size());
   files::write_atomic(dir / "stability.md", md);
   stability_summary(r).write(dir / "summary.yaml");
