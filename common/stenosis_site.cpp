@@ -1,47 +1,237 @@
-// The stenosis site discounting the vessel taper (common/stenosis_site.hpp).
+// The stenosis rule (common/stenosis_site.hpp).
 #include "common/stenosis_site.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "common/config.hpp"
 #include "common/error.hpp"
+#include "common/summary.hpp"
+#include "common/units.hpp"
 
 namespace stentsim {
 
-TaperedStenosis stenosis_discounting_taper(const std::vector<double>& S, const std::vector<double>& R, double lo,
-                                           double hi) {
-  std::vector<std::size_t> inner;
-  for (std::size_t i = 0; i < S.size() && i < R.size(); ++i)
-    if (S[i] >= lo && S[i] <= hi) inner.push_back(i);
-  if (inner.size() < 3) throw ComputeError("stenosis site: fewer than three centerline samples between the ends");
-  // Upper-envelope line: refit on the samples not below the last line by more than 2 % of its mean.
-  double a = 0, b = 0;  // r_ref(s) = a + b s
+StenosisRule parse_stenosis_rule(ConfigMap& m) {
+  StenosisRule r;
+  r.threshold_percent = m.number("threshold_percent", r.threshold_percent, Range{0.0, 100.0, false, false});
+  r.recovery_fraction = m.number("recovery_fraction", r.recovery_fraction, Range{0.0, 1.0, true, false});
+  r.merge_distance = m.quantity("merge_distance", units::kLength, r.merge_distance, Range::non_negative());
+  r.end_exclusion_diameters = m.number("end_exclusion_diameters", r.end_exclusion_diameters, Range::between(0, 20));
+  r.smoothing_window = m.quantity("smoothing_window", units::kLength, r.smoothing_window, Range::non_negative());
+  m.finish();
+  return r;
+}
+
+namespace {
+
+struct Line {
+  double a = 0, b = 0;  // r = a + b s
+};
+
+/// Upper-envelope least-squares line over the samples `inner`.
+Line envelope_line(const std::vector<double>& S, const std::vector<double>& R, const std::vector<std::size_t>& inner) {
+  Line l;
   std::vector<std::size_t> use = inner;
   for (int pass = 0; pass < 8; ++pass) {
     double n = 0, ss = 0, sr = 0, sss = 0, ssr = 0;
     for (std::size_t i : use) n += 1, ss += S[i], sr += R[i], sss += S[i] * S[i], ssr += S[i] * R[i];
     const double det = n * sss - ss * ss;
-    b = det > 1e-12 * n * sss ? (n * ssr - ss * sr) / det : 0.0;
-    a = (sr - b * ss) / n;
+    l.b = det > 1e-12 * n * sss ? (n * ssr - ss * sr) / det : 0.0;
+    l.a = (sr - l.b * ss) / n;
     double mean = 0;
-    for (std::size_t i : inner) mean += a + b * S[i];
+    for (std::size_t i : inner) mean += l.a + l.b * S[i];
     mean /= double(inner.size());
     std::vector<std::size_t> next;
     for (std::size_t i : inner)
-      if (R[i] >= a + b * S[i] - 0.02 * mean) next.push_back(i);
+      if (R[i] >= l.a + l.b * S[i] - 0.02 * mean) next.push_back(i);
     if (next.size() < 2 || next == use) break;
     use = next;
   }
+  return l;
+}
+
+std::vector<std::size_t> samples_between(const std::vector<double>& S, std::size_t n, double lo, double hi) {
+  std::vector<std::size_t> inner;
+  for (std::size_t i = 0; i < n; ++i)
+    if (S[i] >= lo && S[i] <= hi) inner.push_back(i);
+  return inner;
+}
+
+/// Moving average over [s - w/2, s + w/2] (trapezoidal in s, so uneven samples weigh by length).
+std::vector<double> smoothed(const std::vector<double>& S, const std::vector<double>& R, double w) {
+  const std::size_t n = std::min(S.size(), R.size());
+  std::vector<double> out(R.begin(), R.begin() + long(n));
+  if (w <= 0 || n < 2) return out;
+  for (std::size_t i = 0; i < n; ++i) {
+    double sum = 0, len = 0;
+    for (std::size_t j = i; j > 0 && S[i] - S[j - 1] <= 0.5 * w; --j) {
+      const double h = S[j] - S[j - 1];
+      sum += 0.5 * h * (R[j] + R[j - 1]), len += h;
+    }
+    for (std::size_t j = i; j + 1 < n && S[j + 1] - S[i] <= 0.5 * w; ++j) {
+      const double h = S[j + 1] - S[j];
+      sum += 0.5 * h * (R[j] + R[j + 1]), len += h;
+    }
+    if (len > 0) out[i] = sum / len;
+  }
+  return out;
+}
+
+}  // namespace
+
+TaperedStenosis stenosis_discounting_taper(const std::vector<double>& S, const std::vector<double>& R, double lo,
+                                           double hi) {
+  const std::vector<std::size_t> inner = samples_between(S, std::min(S.size(), R.size()), lo, hi);
+  if (inner.size() < 3) throw ComputeError("stenosis site: fewer than three centerline samples between the ends");
+  const Line l = envelope_line(S, R, inner);
   TaperedStenosis t;
-  t.slope = b;
+  t.slope = l.b;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i : inner) {
-    const double ref = a + b * S[i];
+    const double ref = l.a + l.b * S[i];
     if (ref <= 0) continue;
     if (R[i] / ref < best) best = R[i] / ref, t.abscissa = S[i], t.radius = R[i], t.reference_radius = ref;
   }
   if (!std::isfinite(best)) throw ComputeError("stenosis site: the fitted reference radius is not positive");
   return t;
+}
+
+StenosisProfile analyse_stenoses(const std::vector<double>& S, const std::vector<double>& Rraw, const StenosisRule& rule) {
+  const std::size_t n = std::min(S.size(), Rraw.size());
+  if (n < 3) throw ComputeError("stenosis rule: fewer than three centerline samples");
+  const std::vector<double> R = smoothed(S, Rraw, rule.smoothing_window);
+  StenosisProfile p;
+  p.rule = rule;
+  // The ends' exclusion is in reference diameters, so it needs the line; the
+  // line is fitted on the samples the exclusion leaves: two passes settle it
+  // (the line moves little once the tips are out).
+  p.lo = S.front(), p.hi = S[n - 1];
+  Line l = envelope_line(S, R, samples_between(S, n, p.lo, p.hi));
+  for (int pass = 0; pass < 2; ++pass) {
+    const double lo = S.front() + 2 * rule.end_exclusion_diameters * std::max(0.0, l.a + l.b * S.front());
+    const double hi = S[n - 1] - 2 * rule.end_exclusion_diameters * std::max(0.0, l.a + l.b * S[n - 1]);
+    const auto inner = samples_between(S, n, lo, hi);
+    if (inner.size() < 3)
+      throw ComputeError(fmt::format("stenosis rule: the centerline ({:.3g} mm) is shorter than its two excluded ends "
+                                     "({:g} reference diameter(s) each, stenosis.end_exclusion_diameters)",
+                                     S[n - 1] - S.front(), rule.end_exclusion_diameters));
+    p.lo = lo, p.hi = hi;
+    l = envelope_line(S, R, inner);
+  }
+  p.intercept = l.a, p.slope = l.b;
+  const auto inner = samples_between(S, n, p.lo, p.hi);
+  std::vector<double> depth(n, 0.0);  // percent diameter stenosis of the smoothed radius
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i : inner) {
+    const double ref = p.reference_at(S[i]);
+    if (ref <= 0) throw ComputeError(fmt::format("stenosis rule: the fitted reference radius is not positive at s = {:.3g} mm", S[i]));
+    depth[i] = 100 * (1 - R[i] / ref);
+    if (Rraw[i] / ref < best) best = Rraw[i] / ref, p.narrowest = {S[i], Rraw[i], ref, l.b};
+  }
+  // Cores: runs deeper than the threshold; each widens to where the narrowing
+  // has recovered (below recovery_fraction of the threshold) on both sides.
+  // A core that runs into an excluded end without recovering is a tip taper
+  // or a cut lesion, not a lesion the rule can measure.
+  const double recovered = rule.recovery_fraction * rule.threshold_percent;
+  const std::size_t first = inner.front(), last = inner.back();
+  std::vector<Lesion> found;
+  for (std::size_t i = first; i <= last; ++i) {
+    if (depth[i] <= rule.threshold_percent) continue;
+    std::size_t j = i;
+    while (j + 1 <= last && depth[j + 1] > rule.threshold_percent) ++j;
+    std::size_t a = i, b = j;
+    while (a > first && depth[a] > recovered) --a;
+    while (b < last && depth[b] > recovered) ++b;
+    const bool ok = depth[a] <= recovered && depth[b] <= recovered;
+    if (ok) {
+      Lesion les;
+      les.start = S[a], les.end = S[b], les.slope = l.b;
+      // Found on the smoothed radius, measured on the raw one: the narrowest
+      // raw r / r_ref inside the extent.
+      double worst = std::numeric_limits<double>::infinity();
+      for (std::size_t k = a; k <= b; ++k) {
+        const double ref = p.reference_at(S[k]);
+        if (Rraw[k] / ref < worst) worst = Rraw[k] / ref, les.abscissa = S[k], les.radius = Rraw[k], les.reference_radius = ref;
+      }
+      // Overlapping extents (a shallow saddle between two cores) are one lesion.
+      if (!found.empty() && les.start <= found.back().end) {
+        Lesion& prev = found.back();
+        prev.end = std::max(prev.end, les.end);
+        if (les.percent_diameter() > prev.percent_diameter()) {
+          const double s0 = prev.start, s1 = prev.end;
+          prev = les, prev.start = s0, prev.end = s1;
+        }
+      } else {
+        found.push_back(les);
+      }
+    }
+    i = std::max(j, b);
+  }
+  // Narrowings closer than merge_distance are one lesion: the deeper one names it.
+  for (const Lesion& les : found) {
+    if (!p.lesions.empty() && les.abscissa - p.lesions.back().abscissa < rule.merge_distance) {
+      Lesion& prev = p.lesions.back();
+      const double s0 = prev.start;
+      if (les.percent_diameter() > prev.percent_diameter()) prev = les;
+      prev.start = s0, prev.end = les.end;
+    } else {
+      p.lesions.push_back(les);
+    }
+  }
+  return p;
+}
+
+const Lesion* StenosisProfile::most_severe() const {
+  const Lesion* best = nullptr;
+  for (const Lesion& l : lesions)
+    if (!best || l.percent_diameter() > best->percent_diameter()) best = &l;
+  return best;
+}
+
+const Lesion* StenosisProfile::nearest(double s) const {
+  const Lesion* best = nullptr;
+  double bd = std::numeric_limits<double>::infinity();
+  for (const Lesion& l : lesions) {
+    const double d = (s >= l.start && s <= l.end) ? -1.0 : std::abs(s - l.abscissa);
+    if (d < bd) bd = d, best = &l;
+  }
+  return best;
+}
+
+std::string StenosisProfile::no_lesion_message() const {
+  return fmt::format("no lesion deeper than {:g} % diameter stenosis (stenosis.threshold_percent) with recovery on both "
+                     "sides between s = {:.2f} and {:.2f} mm; the narrowest point, at s = {:.2f} mm, is {:.1f} % against "
+                     "the reference",
+                     rule.threshold_percent, lo, hi, narrowest.abscissa, narrowest.percent_diameter());
+}
+
+void report_lesions(const StenosisProfile& p, Summary& summary, const std::string& prefix) {
+  summary.set(prefix + "lesion_count", double(p.lesions.size()));
+  summary.set(prefix + "reference_radius_intercept", p.intercept, "mm");
+  summary.set(prefix + "reference_taper", p.slope);  // dr_ref/ds
+  summary.note(prefix + "lesion_rule",
+               fmt::format("narrowing deeper than {:g} % diameter stenosis against a straight reference line fitted to "
+                           "the radius's upper envelope (follows the taper), recovering below {:g} % on both sides; "
+                           "narrowest points closer than {:g} mm merged; ends excluded by {:g} reference diameter(s); "
+                           "radius averaged over {:g} mm",
+                           p.rule.threshold_percent, p.rule.recovery_fraction * p.rule.threshold_percent,
+                           p.rule.merge_distance, p.rule.end_exclusion_diameters, p.rule.smoothing_window));
+  if (p.lesions.empty()) summary.note(prefix + "lesions", p.no_lesion_message());
+  for (std::size_t k = 0; k < p.lesions.size(); ++k) {
+    const Lesion& l = p.lesions[k];
+    const std::string key = fmt::format("{}lesion_{}_", prefix, k + 1);
+    summary.set(key + "abscissa", l.abscissa, "mm");
+    if (l.point) summary.set(key + "point", std::vector<double>(l.point->begin(), l.point->end()), "mm");
+    summary.set(key + "min_radius", l.radius, "mm");
+    summary.set(key + "reference_radius", l.reference_radius, "mm");
+    summary.set(key + "percent_diameter", l.percent_diameter(), "%");
+    summary.set(key + "percent_area", l.percent_area(), "%");
+    summary.set(key + "start", l.start, "mm");
+    summary.set(key + "end", l.end, "mm");
+  }
 }
 
 }  // namespace stentsim

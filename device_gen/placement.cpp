@@ -24,7 +24,6 @@ PlacementParams parse_placement_params(ConfigMap& section) {
   p.smoothing_tolerance = section.number("smoothing_tolerance", p.smoothing_tolerance, Range::between(1e-12, 0.5));
   p.spacing = section.quantity("spacing", units::kLength, p.spacing, Range::positive());
   p.radius_window = section.quantity("radius_window", units::kLength, p.radius_window, Range::non_negative());
-  p.end_exclusion = section.quantity("end_exclusion", units::kLength, p.end_exclusion, Range::non_negative());
   p.clearance_margin = section.quantity("clearance_margin", units::kLength, p.clearance_margin, Range::non_negative());
   p.weight_factor = section.number("weight_factor", p.weight_factor, Range{1.0, std::nullopt, false, true});
   p.weight_window = section.quantity("weight_window", units::kLength, p.weight_window, Range::non_negative());
@@ -54,15 +53,17 @@ Placement compute_placement(const PlacementParams& prm, const Centerline& cl, co
                                  P.balloon_length));
   const double L = balloon.length;
 
-  // 1. The site. The smoothed inscribed radius at the centerline samples
-  // against a straight reference line on its upper envelope.
-  std::vector<double> smoothed(cl.abscissa.size());
-  for (std::size_t i = 0; i < smoothed.size(); ++i) smoothed[i] = cl.smoothed_radius(cl.abscissa[i], prm.radius_window);
-  const double lo = cl.begin() + prm.end_exclusion, hi = cl.end() - prm.end_exclusion;
-  std::size_t inner = 0;
-  for (double s : cl.abscissa) inner += (s >= lo && s <= hi) ? 1 : 0;
-  std::optional<TaperedStenosis> taper;
-  if (inner >= 3) taper = stenosis_discounting_taper(cl.abscissa, smoothed, lo, hi);
+  // 1. The site: given, or the most severe lesion by the stenosis rule
+  // (common/stenosis_site, as the centerline stage and the segmentation's
+  // region of interest); a vessel with no lesion needs a given site.
+  std::optional<StenosisProfile> prof;
+  try {
+    prof = analyse_stenoses(cl.abscissa, cl.radius, prm.stenosis);
+  } catch (const ComputeError& e) {
+    if (!prm.site_abscissa)
+      throw InputError(fmt::format("placement: {} ({}); give the site with device.placement.site_abscissa", e.what(),
+                                   cl.source));
+  }
   if (prm.site_abscissa) {
     P.site_abscissa = *prm.site_abscissa;
     P.site_chosen_by = "given";
@@ -70,25 +71,22 @@ Placement compute_placement(const PlacementParams& prm, const Centerline& cl, co
       throw InputError(fmt::format("placement: site_abscissa {} mm lies outside the centerline of {} ({} to {} mm)",
                                    P.site_abscissa, cl.source, cl.begin(), cl.end()));
   } else {
-    P.site_chosen_by = "narrowest";
-    // Narrowest relative to the vessel's taper (common/stenosis_site.hpp, the
-    // rule of the segmentation ROI): a distally narrowing healthy lumen must
-    // not win over a mid-vessel stenosis.
-    if (inner < 3)
-      throw InputError(fmt::format("placement: the centerline of {} ({:.4g} mm) has fewer than three samples more than "
-                                   "end_exclusion ({} mm) from its ends",
-                                   cl.source, cl.end() - cl.begin(), prm.end_exclusion));
-    P.site_abscissa = taper->abscissa;
+    const Lesion* lesion = prof->most_severe();
+    if (!lesion)
+      throw InputError(fmt::format("placement: {} ({}); give the site with device.placement.site_abscissa (mm along "
+                                   "the centerline) or lower stenosis.threshold_percent",
+                                   prof->no_lesion_message(), cl.source));
+    P.site_chosen_by = "most severe lesion";
+    P.site_abscissa = lesion->abscissa;
   }
   P.site_point = cl.point_at(P.site_abscissa);
   P.site_radius = cl.radius_at(P.site_abscissa);
   P.site_smoothed_radius = cl.smoothed_radius(P.site_abscissa, prm.radius_window);
-  // The reference (healthy) radius at the site from the same line, so the
-  // percent stenosis follows the segmentation ROI's rule; a given site is
-  // measured against the line fitted over the same range.
-  if (taper) {
-    P.site_reference_radius = taper->reference_radius + taper->slope * (P.site_abscissa - taper->abscissa);
-    P.reference_taper = taper->slope;
+  // The reference (healthy) radius at the site from the rule's line, so the
+  // percent stenosis is the lesion's.
+  if (prof) {
+    P.site_reference_radius = prof->reference_at(P.site_abscissa);
+    P.reference_taper = prof->slope;
   }
 
   // 2. The balloon ends.

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "common/mesh_data.hpp"
+#include "common/stenosis_site.hpp"
 #include "device_gen/balloon_design.hpp"
 #include "device_gen/centerline_input.hpp"
 #include "device_gen/fitpack/curfit.hpp"
@@ -40,8 +41,10 @@ struct PlacementParams {
   double smoothing = 4.0;               // zeta (mm^2, per coordinate)
   double smoothing_tolerance = 0.001;   // epsilon (FITPACK tol)
   double spacing = 0.1;                 // mm, resampling of the centerline between the balloon ends
-  double radius_window = 1.0;           // mm, moving average of the inscribed radius for the narrowest site
-  double end_exclusion = 1.0;           // mm at each centerline end not considered for the narrowest site
+  double radius_window = 1.0;           // mm, moving average of the inscribed radius reported at the site
+  /// The site by default: the most severe lesion of the stenosis rule
+  /// (common/stenosis_site; the case's `stenosis:` section).
+  StenosisRule stenosis;
   double clearance_margin = 0.0;        // mm the device envelope must stay inside the lumen
   double weight_factor = 2.0;           // weights near a violation are multiplied by this per iteration
   double weight_window = 0.5;           // mm around a violating sample whose weights are raised
@@ -49,7 +52,7 @@ struct PlacementParams {
 };
 
 /// Reads a `device.placement` section: site_abscissa, smoothing,
-/// smoothing_tolerance, spacing, radius_window, end_exclusion,
+/// smoothing_tolerance, spacing, radius_window,
 /// clearance_margin, weight_factor, weight_window, max_weight_iterations.
 /// Calls section.finish(). Throws InputError.
 PlacementParams parse_placement_params(ConfigMap& section);
@@ -57,14 +60,14 @@ PlacementParams parse_placement_params(ConfigMap& section);
 struct Placement {
   // Site and ends (centerline abscissae, mm).
   double site_abscissa = 0;
-  std::string site_chosen_by;  // "narrowest" | "given"
+  std::string site_chosen_by;  // "most severe lesion" | "given"
   Eigen::Vector3d site_point = Eigen::Vector3d::Zero();
   double site_radius = 0, site_smoothed_radius = 0;
   // Taper reference line at the site (0 when fewer than three samples lie
   // between the excluded ends) and its slope dr_ref/ds.
   double site_reference_radius = 0, reference_taper = 0;
   double percent_diameter_stenosis() const {
-    return site_reference_radius > 0 ? 100.0 * (1.0 - site_smoothed_radius / site_reference_radius) : 0.0;
+    return site_reference_radius > 0 ? 100.0 * (1.0 - site_radius / site_reference_radius) : 0.0;
   }
   double proximal_abscissa = 0, distal_abscissa = 0;
   // Device used for the envelope.

@@ -49,14 +49,15 @@ void run_placement_stage(const PlacementParams& params, const std::filesystem::p
   write_vtp(out_balloon_centerline_vtp.string(), polyline);
 
   summary.set("stenosis_abscissa", P.site_abscissa, "mm");
-  summary.set("narrowest_lumen_diameter", 2.0 * P.site_smoothed_radius, "mm");  // lumen diameter at the site
+  summary.set("narrowest_lumen_diameter", 2.0 * P.site_radius, "mm");  // inscribed lumen diameter at the site
+  summary.set("smoothed_lumen_diameter", 2.0 * P.site_smoothed_radius, "mm");  // over device.placement.radius_window
+  summary.note("site_chosen_by", P.site_chosen_by);
   if (P.site_reference_radius > 0) {
     summary.set("reference_lumen_diameter", 2.0 * P.site_reference_radius, "mm");
     summary.set("stenosis_percent_diameter", P.percent_diameter_stenosis(), "%");
     summary.set("reference_taper", P.reference_taper);  // dr_ref/ds
-    summary.note("stenosis_rule", "smoothed lumen diameter at the site against a straight reference line "
-                                              "fitted to the radius's upper envelope (discounts the vessel taper; the "
-                                              "segmentation ROI's rule, common/stenosis_site.hpp)");
+    summary.note("stenosis_rule", "lumen diameter at the site against the stenosis rule's reference line "
+                                  "(common/stenosis_site.hpp, as the centerline stage and the segmentation ROI)");
   }
   summary.set("balloon_proximal_abscissa", P.proximal_abscissa, "mm");
   summary.set("balloon_distal_abscissa", P.distal_abscissa, "mm");

@@ -255,16 +255,29 @@ CenterlineResult compute_centerline(const TriSurface& s, const CenterlineOptions
   cl.field_text["centerline_method"] =
       "Voronoi minimal path (cost 1/R) between the ends, resampled and centred in normal planes";
 
-  // Stenosis site and reference radius, away from the ends: the narrowest
-  // radius relative to the healthy reference line (common/stenosis_site, the
-  // rule of the segmentation ROI and the device placement), so a tapering
-  // vessel's healthy distal end is not reported as the stenosis.
+  // Lesions and the reference line by the one stenosis rule
+  // (common/stenosis_site, as the segmentation ROI, the wall synthesis and the
+  // device placement); the site is the most severe lesion, or the narrowest
+  // point relative to the reference when there is none.
   res.length = abscissa.back();
-  double lo = o.end_exclusion_radii * radius.front(), hi = res.length - o.end_exclusion_radii * radius.back();
-  if (std::count_if(abscissa.begin(), abscissa.end(), [&](double s) { return s >= lo && s <= hi; }) < 3)
-    lo = 0, hi = res.length;  // a segment shorter than its end exclusions: use every sample
-  const TaperedStenosis site = stenosis_discounting_taper(abscissa, radius, lo, hi);
-  auto ref_at = [&](double s) { return site.reference_radius + site.slope * (s - site.abscissa); };
+  try {
+    res.stenoses = analyse_stenoses(abscissa, radius, o.stenosis);
+  } catch (const ComputeError& e) {
+    // A lumen shorter than its excluded ends still has a centerline; its
+    // lesions are then looked for over every sample, and the log says so.
+    StenosisRule all = o.stenosis;
+    all.end_exclusion_diameters = 0;
+    res.stenoses = analyse_stenoses(abscissa, radius, all);
+    log::warn("centerline: {}; the stenosis rule looks at the whole {:.3g} mm instead", e.what(), abscissa.back());
+  }
+  for (Lesion& l : res.stenoses.lesions) {
+    const std::size_t k = std::size_t(std::lower_bound(abscissa.begin(), abscissa.end(), l.abscissa) - abscissa.begin());
+    const Eigen::Vector3d& x = pts[std::min(k, n - 1)];
+    l.point = std::array<double, 3>{x.x(), x.y(), x.z()};
+  }
+  const Lesion* worst = res.stenoses.most_severe();
+  const TaperedStenosis site = worst ? static_cast<const TaperedStenosis&>(*worst) : res.stenoses.narrowest;
+  auto ref_at = [&](double s) { return res.stenoses.reference_at(s); };
   std::size_t imin = std::size_t(std::find(abscissa.begin(), abscissa.end(), site.abscissa) - abscissa.begin());
   // Parabola through the smallest ratio r / r_ref and its neighbours for a sub-sample site.
   res.stenosis_abscissa = abscissa[imin];

@@ -20,6 +20,7 @@
 #include <optional>
 
 #include "common/config.hpp"
+#include "common/stenosis_site.hpp"
 #include "common/mesh_data.hpp"
 #include "common/summary.hpp"
 #include "segmentation_io/triangle_surface.hpp"
@@ -36,9 +37,9 @@ struct CenterlineOptions {
   /// Healthy reference radius for the % diameter stenosis; default: the
   /// taper line of common/stenosis_site at the stenosis site.
   std::optional<double> reference_radius;
-  /// The narrowest site and the reference are searched this many local radii
-  /// away from the ends.
-  double end_exclusion_radii = 1.0;
+  /// The lesions and the reference line (common/stenosis_site; the case's
+  /// `stenosis:` section, shared with the ROI, wall synthesis and placement).
+  StenosisRule stenosis;
   /// A true centerline (phantom) to report accuracy against.
   std::optional<std::filesystem::path> true_centerline;
 };
@@ -51,8 +52,10 @@ CenterlineOptions parse_centerline_options(ConfigMap& section);
 struct CenterlineResult {
   MeshData centerline;  // one polyline with the point arrays listed above
   double length = 0;                  // mm
-  // The stenosis discounts the taper (common/stenosis_site): the site is the
-  // smallest r / r_ref(s), r_ref a straight line fitted to the radius's upper envelope.
+  /// Lesions and reference line by the stenosis rule (common/stenosis_site).
+  StenosisProfile stenoses;
+  // The site below is the most severe lesion's, or the narrowest point
+  // relative to the reference line when there is no lesion.
   double min_radius = 0;              // mm, lumen radius at the stenosis site
   double stenosis_abscissa = 0;       // mm, stenosis site along the centerline
   Eigen::Vector3d stenosis_point = Eigen::Vector3d::Zero();

@@ -21,7 +21,6 @@ CenterlineOptions parse_centerline_options(ConfigMap& section) {
   o.centering_passes = section.integer("centering_passes", 2, Range::between(0, 10));
   if (section.has("reference_radius"))
     o.reference_radius = section.quantity("reference_radius", units::kLength, std::nullopt, Range::positive());
-  o.end_exclusion_radii = section.number("end_exclusion_radii", 1.0, Range::non_negative());
   if (section.has("true_centerline")) o.true_centerline = section.path("true_centerline");
   section.finish();
   return o;
@@ -52,8 +51,10 @@ void run_centerline_stage(const CenterlineOptions& options, const std::filesyste
   summary.note("reference_radius", options.reference_radius ? "given in the case"
                                                             : "straight line fitted to the inscribed radius's upper "
                                                               "envelope away from the ends, at the stenosis site");
-  summary.note("stenosis_rule", "smallest radius relative to the reference line (discounts the vessel taper; "
-                                "common/stenosis_site, as the ROI and the placement)");
+  summary.note("stenosis_site", r.stenoses.lesions.empty()
+                                    ? "no lesion: the narrowest point relative to the reference line"
+                                    : "the most severe lesion (lesion_<k>_*: every lesion)");
+  report_lesions(r.stenoses, summary);
   summary.note("centerline_method", r.centerline.field_text["centerline_method"]);
   log::info("centerline: {:.2f} mm, stenosis radius {:.4f} mm at {:.2f} mm ({:.1f} % diameter stenosis), {:.2f} s",
             r.length, r.min_radius, r.stenosis_abscissa, r.stenosis_percent_diameter, r.seconds);

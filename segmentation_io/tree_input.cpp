@@ -63,19 +63,44 @@ Vector3d farthest_point_along_surface(const TriSurface& tree, const Vector3d& fr
   return s.points[far] - inset * sign * normal[far].normalized();
 }
 
-TriSurface clip_region_of_interest(const TriSurface& lumen, const CenterlineResult& cl, double length, double& s0,
-                                   double& s1, TaperedStenosis* site_out) {
+TriSurface clip_region_of_interest(const TriSurface& lumen, const CenterlineResult& cl, double length,
+                                   const StenosisRule& rule, std::optional<double> center, double& s0, double& s1,
+                                   TaperedStenosis* site_out, StenosisProfile* profile_out) {
   const auto& P = cl.centerline.points;
   const auto& S = cl.centerline.point_data.at("Abscissas").values;
   const auto& R = cl.centerline.point_data.at("MaximumInscribedSphereRadius").values;
   const std::size_t n = P.size();
   if (n < 4) throw ComputeError("region of interest: the centerline has fewer than four points");
-  const double lo = S.front() + R.front(), hi = S.back() - R.back();
+  const StenosisProfile prof = analyse_stenoses(S, R, rule);
+  if (profile_out) *profile_out = prof;
+  // The cut planes stay a reference radius inside the segment's ends (the
+  // lesions are looked for further in, prof.lo to prof.hi).
+  const double lo = S.front() + std::max(0.0, prof.reference_at(S.front())),
+               hi = S.back() - std::max(0.0, prof.reference_at(S.back()));
   if (hi - lo < length)
     throw InputError(fmt::format("region of interest: {:.3g} mm asked, but the vessel segment offers {:.3g} mm between "
-                                 "its ends (less a radius at each)", length, std::max(0.0, hi - lo)));
-  // The site discounting the taper (the narrowest radius may be the healthy distal end).
-  const TaperedStenosis site = stenosis_discounting_taper(S, R, lo, hi);
+                                 "its ends (less a reference radius at each); set input.tree.roi_length to {:.3g} mm "
+                                 "or less",
+                                 length, std::max(0.0, hi - lo), std::floor(10 * std::max(0.0, hi - lo)) / 10));
+  if (center && (*center < S.front() || *center > S.back()))
+    throw InputError(fmt::format("input.tree.roi_center: {:.4g} mm lies outside the extracted segment (0 to {:.4g} mm "
+                                 "along its centerline)", *center, S.back()));
+  const Lesion* lesion = prof.most_severe();
+  if (center) {  // the lesion that spans the given centre, else the centre itself
+    lesion = prof.nearest(*center);
+    if (lesion && !(*center >= lesion->start && *center <= lesion->end)) lesion = nullptr;
+  }
+  if (!lesion && !center)
+    throw InputError(fmt::format("region of interest: {}; name the region's centre with input.tree.roi_center (an "
+                                 "abscissa in mm along the extracted segment, e.g. {:.1f}) or lower "
+                                 "stenosis.threshold_percent",
+                                 prof.no_lesion_message(), prof.narrowest.abscissa));
+  TaperedStenosis site = lesion ? static_cast<const TaperedStenosis&>(*lesion) : prof.narrowest;
+  if (center && !lesion) {  // no lesion: the region sits where the user put it
+    site.abscissa = *center;
+    site.reference_radius = prof.reference_at(*center);
+    site.radius = site.reference_radius;
+  }
   if (site_out) *site_out = site;
   s0 = std::clamp(site.abscissa - 0.5 * length, lo, hi - length);
   s1 = s0 + length;

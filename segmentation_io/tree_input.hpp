@@ -19,18 +19,17 @@ namespace stentsim::segmentation {
 /// vessel from the inlet.
 Eigen::Vector3d farthest_point_along_surface(const TriSurface& tree, const Eigen::Vector3d& from, double inset);
 
-/// The taper-discounted stenosis site lives in common/ (shared with the
-/// device placement).
-using stentsim::TaperedStenosis;
-using stentsim::stenosis_discounting_taper;
-
-/// The part of a vessel segment within ±length/2 (along its centerline) of
-/// the stenosis (stenosis_discounting_taper between a local radius from each
-/// end), cut by planes normal to the centerline; the window is
-/// shifted to stay a local radius inside the segment's ends. `s0`, `s1`
-/// receive the kept abscissae, `site` (when given) the stenosis. InputError when the segment is shorter than
-/// `length`.
+/// The part of a vessel segment within ±length/2 (along its centerline) of a
+/// lesion, cut by planes normal to the centerline: with `center` (an abscissa
+/// of `centerline`) the lesion that spans it, or that abscissa itself; else
+/// the most severe lesion by the stenosis rule (common/stenosis_site); with no lesion and no
+/// center, an InputError that says so and names input.tree.roi_center. The
+/// window is shifted to stay inside the rule's analysed range. `s0`, `s1`
+/// receive the kept abscissae, `profile` (when given) the rule's result and
+/// `site` the lesion it is centred on. InputError when the segment is shorter
+/// than `length`.
 TriSurface clip_region_of_interest(const TriSurface& lumen, const CenterlineResult& centerline, double length,
-                                   double& s0, double& s1, TaperedStenosis* site = nullptr);
+                                   const StenosisRule& rule, std::optional<double> center, double& s0, double& s1,
+                                   TaperedStenosis* site = nullptr, StenosisProfile* profile = nullptr);
 
 }  // namespace stentsim::segmentation

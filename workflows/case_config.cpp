@@ -130,6 +130,12 @@ CaseConfig load_case(const std::filesystem::path& file) {
   c.fibers = parse_fibers(top.map("fibers"));
   c.simulation = parse_simulation(top.map("simulation"));
   c.output = parse_output(top.map("output"));
+  if (top.has("stenosis") && c.scene != Scene::patient)
+    top.fail("stenosis", "a " + std::string(to_string(c.scene)) + " scene has no lumen to find lesions in; remove this section");
+  {
+    auto st = top.map("stenosis");
+    c.stenosis = parse_stenosis_rule(st);
+  }
   // Input and device sections are validated by the parsers of the stages
   // that read them (case_sections.cpp), so a bad key fails before any run.
   validate_stage_sections(c, top);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "common/stenosis_site.hpp"
 #include "meshing/generic_artery.hpp"
 #include "meshing/patient_mesh.hpp"
 #include "solver/linalg/linear_solver.hpp"
@@ -62,6 +63,10 @@ struct CaseConfig {
   FiberSettings fibers;
   SimulationSettings simulation;
   OutputSettings output;
+  /// The one stenosis rule (`stenosis:`; patient scenes): the segmentation's
+  /// region of interest and wall synthesis, the centerline stage's lesions
+  /// and the placement's site.
+  StenosisRule stenosis;
 
   /// The raw YAML of a section ("device.stent"); an empty map when absent.
   YAML::Node section(const std::string& dotted) const;

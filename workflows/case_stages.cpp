@@ -99,15 +99,17 @@ Stage harmonic_fibers_stage(const CaseConfig& c) {
 
 segmentation::SegmentationInput segmentation_input(const CaseConfig& c) {
   ConfigMap input(c.section("input"), std::make_shared<const std::filesystem::path>(c.file), "input");
-  return segmentation::parse_segmentation_input(input);
+  auto in = segmentation::parse_segmentation_input(input);
+  in.stenosis = c.stenosis;
+  return in;
 }
 
 Stage segmentation_stage(const CaseConfig& c) {
   Stage s;
   s.name = "segmentation";
   s.outputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp"};
-  s.config = slice(c, {"input"});
-  s.version = "1";
+  s.config = slice(c, {"input", "stenosis"});
+  s.version = "2";  // 2: wall synthesized per section by the layer rule; ROI on the stenosis rule's lesions
   const auto input = segmentation_input(c);
   if (input.is_phantom()) {
     s.outputs.push_back("segmentation/centerline_true.vtp");
@@ -129,10 +131,11 @@ Stage centerline_stage(const CaseConfig& c) {
   s.name = "centerline";
   s.inputs = {"segmentation/lumen.vtp"};
   s.outputs = {"centerline/centerline.vtp"};
-  s.config = slice(c, {"centerline"});
-  s.version = "1";
+  s.config = slice(c, {"centerline", "stenosis"});
+  s.version = "2";  // 2: lesions by the stenosis rule
   ConfigMap section(c.section("centerline"), std::make_shared<const std::filesystem::path>(c.file), "centerline");
   segmentation::CenterlineOptions options = segmentation::parse_centerline_options(section);
+  options.stenosis = c.stenosis;
   // A phantom's true centerline is an input too: the stage reports its
   // accuracy against it (inscribed_radius_error_max, stenosis_site_error).
   const bool phantom = segmentation_input(c).is_phantom();
@@ -166,10 +169,11 @@ Stage placement_stage(const CaseConfig& c) {
   s.inputs = {"centerline/centerline.vtp", "segmentation/lumen.vtp"};
   s.outputs = {"placement/placement.yaml", "placement/balloon_centerline.vtp"};
   // Placement uses the balloon length and the stent's length and envelope too.
-  s.config = slice(c, {"device"});
-  s.version = "1";
+  s.config = slice(c, {"device", "stenosis"});
+  s.version = "2";  // 2: the site is the most severe lesion of the stenosis rule
   auto p = section_map(c, "device.placement");
-  const auto params = device_gen::parse_placement_params(p);
+  auto params = device_gen::parse_placement_params(p);
+  params.stenosis = c.stenosis;
   const auto d = device_design(c);
   s.run = [params, d](StageContext& ctx) {
     device_gen::run_placement_stage(params, ctx.input("centerline/centerline.vtp"), ctx.input("segmentation/lumen.vtp"),

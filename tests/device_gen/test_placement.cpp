@@ -86,7 +86,7 @@ TEST(DeviceGenPlacement, StraightDipFindsNarrowestSiteAndReproducesFromFile) {
   const Centerline cl = centerline_from_mesh(centerline_mesh(straight_x(), 30.0, radius), "synthetic.vtp");
   const Placement P = compute_placement(PlacementParams{}, cl, nullptr, BalloonDesign{}, StentDesign{});
   EXPECT_NEAR(P.site_abscissa, 12.0, 1e-9);
-  EXPECT_EQ(P.site_chosen_by, "narrowest");
+  EXPECT_EQ(P.site_chosen_by, "most severe lesion");
   EXPECT_NEAR(P.proximal_abscissa, 7.3, 1e-9);
   EXPECT_NEAR(P.distal_abscissa, 16.7, 1e-9);
   EXPECT_EQ(P.x.size(), 95u);

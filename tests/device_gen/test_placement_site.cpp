@@ -152,19 +152,17 @@ TEST(DeviceGenPlacementSite, BalloonCentredAtKnownStenosisInsideCurvedLumen) {
   // Site: the smoothed radius of a symmetric dip on a constant healthy radius
   // is smallest at the dip's centre, and the site is chosen among centerline
   // samples: it must be s* within half a sample spacing.
-  EXPECT_EQ(P.site_chosen_by, "narrowest");
+  EXPECT_EQ(P.site_chosen_by, "most severe lesion");
   EXPECT_NEAR(P.site_abscissa, s_true, 0.5 * kSample);
   // Reference (healthy) radius 1.0 (the upper-envelope line drops the dip);
-  // percent stenosis of the 1 mm moving average: 100 * 0.25 * mean of the
-  // Gaussian over +-0.5 mm = 100 * 0.25 * 0.9275 = 23.19 %.
+  // percent stenosis of the inscribed radius at the site: 25 %.
   // The envelope fit keeps samples down to 2 % below the line, so the
   // Gaussian's tails (deficit < 0.02 beyond 2.4 mm from the site) pull r_ref
   // a little below 1.0: measured 0.9990; allowed 2e-3.
   EXPECT_NEAR(P.site_reference_radius, 1.0, 2e-3);
   EXPECT_NEAR(P.reference_taper, 0.0, 1e-4);
-  const double gaussian_mean = std::sqrt(std::numbers::pi) * 1.5 * std::erf(0.5 / 1.5);  // integral over [-0.5, 0.5]
   // With r_ref within 2e-3: d(%DS) = 100 (r / r_ref) dr_ref / r_ref < 100 * 0.76 * 2e-3 = 0.15 %.
-  EXPECT_NEAR(P.percent_diameter_stenosis(), 100 * 0.25 * gaussian_mean, 0.15);
+  EXPECT_NEAR(P.percent_diameter_stenosis(), 25.0, 0.15);
 
   // Ends at +- L/2 of arc length along the centerline.
   EXPECT_NEAR(P.proximal_abscissa, P.site_abscissa - 0.5 * L, 1e-12);
@@ -249,16 +247,14 @@ TEST(DeviceGenPlacementSite, TaperingVesselStenosisMidVesselNotTheDistalEnd) {
   // The test can fail: the raw rule picks the distal end, where a 9.4 mm balloon does not even fit.
   double raw_min = std::numeric_limits<double>::infinity(), raw_at = 0;
   for (double s : cl.abscissa)
-    if (s >= prm.end_exclusion && s <= length - prm.end_exclusion && cl.smoothed_radius(s, prm.radius_window) < raw_min)
+    if (s >= 1.0 && s <= length - 1.0 && cl.smoothed_radius(s, prm.radius_window) < raw_min)
       raw_min = cl.smoothed_radius(s, prm.radius_window), raw_at = s;
-  EXPECT_NEAR(raw_at, length - prm.end_exclusion, 1e-9);
+  EXPECT_NEAR(raw_at, length - 1.0, 1e-9);
 
   const Placement P = compute_placement(prm, cl, nullptr, BalloonDesign{}, StentDesign{});
-  // Expected: the 1 mm moving average of (linear x symmetric dip) at the
-  // centre is healthy(12) (1 - 0.30 m), m = mean of the cosine bump over
-  // +-0.5 mm = 0.5 (1 + (4/pi) sin(pi/4)); the reference line is healthy(s).
-  const double m = 0.5 * (1 + 4 / std::numbers::pi * std::sin(std::numbers::pi / 4));
-  const double expected_pct = 100 * 0.30 * m;
+  // Expected: the lesion's 30 % (inscribed radius at the site against the
+  // reference line, which is healthy(s)).
+  const double expected_pct = 30.0;
   std::printf("raw narrowest %.3f mm at %.2f mm; taper-discounted site %.3f mm, r %.4f, r_ref %.4f (true %.4f), "
               "slope %.5f, %%DS %.3f (expected %.3f, true 30)\n",
               raw_min, raw_at, P.site_abscissa, P.site_smoothed_radius, P.site_reference_radius, healthy(s_true),

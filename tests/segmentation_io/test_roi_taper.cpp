@@ -96,7 +96,7 @@ TEST(RoiTaper, RegionOfInterestIsCentredOnTheStenosisNotTheDistalEnd) {
   const TriSurface lumen = tapered_tube(400, 48);
   double s0 = 0, s1 = 0;
   TaperedStenosis site;
-  const TriSurface roi = clip_region_of_interest(lumen, cl, 8.0, s0, s1, &site);
+  const TriSurface roi = clip_region_of_interest(lumen, cl, 8.0, StenosisRule{}, std::nullopt, s0, s1, &site);
   std::printf("ROI %.3f .. %.3f mm around %.3f mm\n", s0, s1, site.abscissa);
   EXPECT_NEAR(0.5 * (s0 + s1), 6.0, 0.11);
   EXPECT_NEAR(s1 - s0, 8.0, 1e-9);

@@ -56,18 +56,22 @@ TEST(TreeInput, LongestPathFromInletWithRegionOfInterest) {
   EXPECT_GT(diag, 10.0);
   EXPECT_LT(diag, 25.0);
 
-  // The region is centred on the taper-discounted stenosis (common/stenosis_site):
+  // The region is centred on the most severe lesion (common/stenosis_site):
   // recompute it here from the same longest path, independently of the stage.
   TriSurface tree = read_surface_file(f);
   const Eigen::Vector3d from(-33.07, 19.97, -22.39);
   BranchSegment seg = extract_branch(tree, from, farthest_point_along_surface(tree, from, 0.3));
   const auto& S = seg.centerline.centerline.point_data.at("Abscissas").values;
   const auto& R = seg.centerline.centerline.point_data.at("MaximumInscribedSphereRadius").values;
-  const double lo = S.front() + R.front(), hi = S.back() - R.back();
-  const TaperedStenosis site = stenosis_discounting_taper(S, R, lo, hi);
+  const StenosisProfile prof = analyse_stenoses(S, R);
+  ASSERT_NE(prof.most_severe(), nullptr) << prof.no_lesion_message();
+  const Lesion& site = *prof.most_severe();
+  const double lo = S.front() + prof.reference_at(S.front()), hi = S.back() - prof.reference_at(S.back());
   const double reported = q["roi_stenosis_abscissa"]["value"].as<double>();
-  std::printf("stenosis site: %.3f mm (stage %.3f mm), %.1f %% diameter, taper %.4f; window allowed [%.2f, %.2f]\n",
-              site.abscissa, reported, site.percent_diameter(), site.slope, lo, hi);
+  std::printf("most severe lesion: %.3f mm (stage %.3f mm), %.1f %% diameter, taper %.4f, %zu lesion(s); window "
+              "allowed [%.2f, %.2f]\n",
+              site.abscissa, reported, site.percent_diameter(), site.slope, prof.lesions.size(), lo, hi);
+  EXPECT_EQ(q["tree_lesion_count"]["value"].as<double>(), double(prof.lesions.size()));
   EXPECT_NEAR(reported, site.abscissa, 1e-9);  // deterministic: the same path and the same rule
   ASSERT_GT(site.abscissa - 7.5, lo) << "the window would be clamped at the inlet; pick another test vessel";
   ASSERT_LT(site.abscissa + 7.5, hi) << "the window would be clamped at the outlet; pick another test vessel";

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "common/files.hpp"
+#include "common/summary.hpp"
 #include "tests/workflows/cli_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -71,6 +72,33 @@ TEST_F(Cli, InitRunStatusAndSecondRunSkipsEveryStage) {
     r = sh("init " + dir.string() + " --scene " + scene);
     EXPECT_EQ(r.code, 2) << r.out;
   }
+}
+
+// The case's `stenosis:` section is the one rule of the centerline stage and
+// the placement: case2-rca's 20 % lesion is listed in the centerline summary;
+// with threshold_percent 30 there is no lesion, the placement says so and
+// names device.placement.site_abscissa, and giving it clears the error.
+TEST_F(Cli, StenosisSectionReachesCenterlineAndPlacement) {
+  const auto c = dir / "case.yaml";
+  const std::string base = "name: st\nscene: patient\ninput: {phantom: {preset: case2-rca}}\n";
+  stentsim::files::write_atomic(c, base);
+  auto r = sh("run " + c.string() + " --until placement");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto summary = stentsim::Summary::read(dir / "st.work" / "centerline" / "summary.yaml");
+  ASSERT_EQ(std::get<double>(summary.qois().at("lesion_count").value), 1.0) << r.out;
+  EXPECT_NEAR(std::get<double>(summary.qois().at("lesion_1_percent_diameter").value), 20.0, 2.0);
+  stentsim::files::write_atomic(c, base + "stenosis: {threshold_percent: 30}\n");
+  r = sh("run " + c.string() + " --until placement");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("no lesion deeper than 30 %"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("device.placement.site_abscissa"), std::string::npos) << r.out;
+  stentsim::files::write_atomic(c, base + "stenosis: {threshold_percent: 30}\ndevice: {placement: {site_abscissa: 12 mm}}\n");
+  r = sh("run " + c.string() + " --until placement");
+  EXPECT_EQ(r.code, 0) << r.out;
+  stentsim::files::write_atomic(c, "scene: free-expansion\nstenosis: {threshold_percent: 30}\n");
+  r = sh("run " + c.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("stenosis: a free-expansion scene has no lumen"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, ForceUntilAndOnlyParseInEveryForm) {
