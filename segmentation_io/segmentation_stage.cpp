@@ -4,12 +4,24 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "segmentation_io/centerline.hpp"
 #include "segmentation_io/label_image.hpp"
 #include "segmentation_io/simvascular_io.hpp"
 #include "segmentation_io/surface_distance.hpp"
 #include "segmentation_io/tree_input.hpp"
 
 namespace stentsim::segmentation {
+
+double robust_reference_diameter(const StenosisProfile& p) { return 2 * p.reference_at(0.5 * (p.lo + p.hi)); }
+
+WallSynthesisOptions parse_wall_synthesis(ConfigMap& section) {
+  WallSynthesisOptions o;
+  if (section.has("wall_thickness"))
+    o.wall_thickness = section.quantity("wall_thickness", units::kLength, std::nullopt, Range::positive());
+  o.nominal_intima = section.quantity("nominal_intima", units::kLength, o.nominal_intima, Range::positive());
+  o.remodeling = section.number("remodeling", o.remodeling, Range::between(0, 1));
+  return o;
+}
 
 SurfaceInput parse_surface_input(ConfigMap& section) {
   SurfaceInput in;
@@ -18,8 +30,7 @@ SurfaceInput parse_surface_input(ConfigMap& section) {
   in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
   in.checks.repair = section.boolean("repair", true);
   in.checks.expected_open_ends = section.integer("open_ends", 2, Range::between(0, 2));
-  in.synthesis.wall_thickness = section.quantity("wall_thickness", units::kLength, 0.5, Range::positive());
-  in.synthesis.remodeling = section.number("remodeling", 0.0, Range::between(0, 1));
+  in.synthesis = parse_wall_synthesis(section);
   section.finish();
   if (in.checks.expected_open_ends != 2 && !in.wall)
     section.fail("open_ends", "a lumen for the pipeline needs its two open ends (proximal and distal cuts)");
@@ -34,8 +45,7 @@ SimVascularInput parse_simvascular_input(ConfigMap& section) {
   in.points_per_contour = section.integer("points_per_contour", 64, Range::between(8, 1024));
   in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
   in.checks.repair = section.boolean("repair", true);
-  in.synthesis.wall_thickness = section.quantity("wall_thickness", units::kLength, 0.5, Range::positive());
-  in.synthesis.remodeling = section.number("remodeling", 0.0, Range::between(0, 1));
+  in.synthesis = parse_wall_synthesis(section);
   section.finish();
   auto ext = [&](const std::filesystem::path& f, const char* e, const std::string& key) {
     if (f.extension() != e) section.fail(key, fmt::format("expected a SimVascular {} file, got `{}`", e, f.string()));
@@ -55,8 +65,7 @@ LabelImageInput parse_label_image_input(ConfigMap& section) {
   in.end_trim = section.quantity("end_trim", units::kLength, 0.0, Range::non_negative());
   in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
   in.checks.repair = section.boolean("repair", true);
-  in.synthesis.wall_thickness = section.quantity("wall_thickness", units::kLength, 0.5, Range::positive());
-  in.synthesis.remodeling = section.number("remodeling", 0.0, Range::between(0, 1));
+  in.synthesis = parse_wall_synthesis(section);
   section.finish();
   if (in.wall_label && *in.wall_label == in.lumen_label)
     section.fail("wall_label", "must differ from lumen_label");
@@ -80,9 +89,12 @@ TreeInput parse_tree_input(ConfigMap& section) {
     in.to = Eigen::Vector3d(t[0], t[1], t[2]);
   }
   if (section.has("roi_length")) in.roi_length = section.quantity("roi_length", units::kLength, std::nullopt, Range::positive());
+  if (section.has("roi_center")) {
+    if (!in.roi_length) section.fail("roi_center", "needs roi_length (the region's length)");
+    in.roi_center = section.quantity("roi_center", units::kLength, std::nullopt, Range::non_negative());
+  }
   in.repair = section.boolean("repair", true);
-  in.synthesis.wall_thickness = section.quantity("wall_thickness", units::kLength, 0.5, Range::positive());
-  in.synthesis.remodeling = section.number("remodeling", 0.0, Range::between(0, 1));
+  in.synthesis = parse_wall_synthesis(section);
   section.finish();
   if (longest == bool(in.to))
     section.fail(in.to ? "to" : "longest_path_from_inlet",
@@ -225,12 +237,13 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     {  // Size says other units? (the same plausibility bounds as the surface checks)
       const SurfaceCheckOptions bounds;
       const double diag = bounding_box_diagonal(tree);
-      if (diag < bounds.min_size || diag > bounds.max_size)
-        throw InputError(fmt::format("{}: the tree is {:.4g} mm across with units: {}; a coronary tree is {:g} to {:g} mm{}",
+      if (diag < bounds.min_size || diag > bounds.max_size) {
+        const std::string u = likely_units(diag, tr->units, bounds.min_size, bounds.max_size);
+        throw InputError(fmt::format("{}: the tree is {:.4g} mm across with input.tree.units: {}; a coronary tree is {:g} "
+                                     "to {:g} mm{}",
                                      tr->file.string(), diag, tr->units, bounds.min_size, bounds.max_size,
-                                     diag * 1000 >= bounds.min_size && diag * 1000 <= bounds.max_size
-                                         ? " (the file looks like it is in metres: set units: m)"
-                                         : ""));
+                                     u.empty() ? "" : fmt::format(" (the file looks like it is in {}: set input.tree.units: {})", unit_word(u), u)));
+      }
     }
     Eigen::Vector3d to = tr->to ? *tr->to : farthest_point_along_surface(tree, tr->from, 0.3);
     BranchSegment seg = extract_branch(tree, tr->from, to);
@@ -239,17 +252,22 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     if (!tr->to) summary.note("tree_path_end", fmt::format("longest path from the inlet ends at ({:.3f}, {:.3f}, {:.3f}) mm",
                                                            to.x(), to.y(), to.z()));
     lumen_raw = std::move(seg.lumen);
+    // Units by the reference diameter of the whole extracted vessel (its
+    // region of interest may sit on a small distal part).
+    check_reference_diameter_units(robust_reference_diameter(seg.centerline.stenoses), tr->units,
+                                   tr->file.string() + " (extracted segment)", "input.tree.units");
     if (tr->roi_length) {
       double s0 = 0, s1 = 0;
       TaperedStenosis site;
-      lumen_raw = clip_region_of_interest(lumen_raw, seg.centerline, *tr->roi_length, s0, s1, &site);
+      StenosisProfile profile;
+      lumen_raw = clip_region_of_interest(lumen_raw, seg.centerline, *tr->roi_length, input.stenosis, tr->roi_center, s0,
+                                          s1, &site, &profile);
       summary.set("roi_start_abscissa", s0, "mm");
       summary.set("roi_end_abscissa", s1, "mm");
       summary.set("roi_stenosis_abscissa", site.abscissa, "mm");
       summary.set("roi_stenosis_percent_diameter", site.percent_diameter(), "%");
-      summary.set("roi_reference_taper", site.slope);  // dr_ref/ds
-      summary.note("roi_stenosis", "narrowest radius relative to a straight reference line fitted to the radius's upper "
-                                   "envelope (discounts the vessel taper)");
+      summary.note("roi_centre", tr->roi_center ? "input.tree.roi_center" : "the most severe lesion of the segment");
+      report_lesions(profile, summary, "tree_");  // along the whole extracted segment
     }
     lumen_name = tr->file.string() + " (extracted segment)";
     checks.units = "mm";  // already scaled
@@ -272,6 +290,14 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
   SurfaceReport lr;
   TriSurface lumen = check_and_repair(std::move(lumen_raw), checks, lumen_name, lr);
   report_to_summary("lumen", lr, summary);
+  // The lumen's centerline and lesions, for the units rule and the wall.
+  CenterlineOptions co;
+  co.stenosis = input.stenosis;
+  const CenterlineResult lumen_centerline = compute_centerline(lumen, co);
+  const double d_ref = robust_reference_diameter(lumen_centerline.stenoses);
+  summary.set("lumen_reference_diameter", d_ref, "mm");
+  if (kind != "tree")  // a tree's whole extracted segment was checked above
+    check_reference_diameter_units(d_ref, checks.units, lumen_name, "input." + kind + ".units");
   TriSurface wall;
   if (have_wall) {
     SurfaceReport wr;
@@ -298,9 +324,9 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
                                    lumen_name, outside, sample.size(), wall_name));
     summary.set_text("wall_source", "file");
   } else {
-    wall = synthesize_wall(lumen, synthesis);
+    synthesis.stenosis = input.stenosis;
+    wall = synthesize_wall(lumen, synthesis, summary, &lumen_centerline);
     summary.set_text("wall_source", "synthesized from the lumen");
-    summary.set("wall_thickness_healthy", synthesis.wall_thickness, "mm");
     summary.set("wall_remodeling", synthesis.remodeling);
   }
   write_vtp(out_lumen_vtp.string(), to_output(lumen, lumen_name));

@@ -6,23 +6,40 @@
 #include <variant>
 
 #include "common/config.hpp"
+#include "common/stenosis_site.hpp"
 #include "common/summary.hpp"
 #include "segmentation_io/phantom.hpp"
 #include "segmentation_io/surface_input.hpp"
 
 namespace stentsim::segmentation {
 
-/// Outer wall made from the lumen alone (issue 3): a tube of circles normal to
-/// the lumen centerline with radius R_ref + t + remodeling·(R_ref − r)₊, never
-/// closer than t/2 to the lumen; R_ref(s) is the healthy reference line of
-/// common/stenosis_site (fitted to the radius's upper envelope: the segments
-/// either side of the stenosis, taper kept), r the local inscribed radius, so
-/// the plaque fills the space between.
+struct CenterlineResult;  // segmentation_io/centerline.hpp
+
+/// Outer wall made from the lumen alone (DESIGN.md §8). Per cross-section
+/// normal to the lumen centerline: the lumen's polar contour (rays from the
+/// centerline) is inflated to the healthy reference size r_ref(s) of the
+/// stenosis rule where plaque narrows it (a healthy or oval lumen keeps its
+/// shape), then dilated by the wall thickness t(s) as a distance level set in
+/// the section plane (star-shaped about the centerline, never folding).
+/// Rays that miss the lumen (open or oblique ends, ostia) are interpolated
+/// from their neighbours. t(s) follows the layer rule
+/// t = (t_I + 0.2146 D_ref)/0.5708 unless a fixed wall_thickness is given.
 struct WallSynthesisOptions {
-  double wall_thickness = 0.5;  // mm, healthy wall
-  double remodeling = 0.0;      // outward growth of the outer wall per mm of plaque (0: none, 1: full)
+  std::optional<double> wall_thickness;  // mm, fixed; absent: the layer rule
+  double nominal_intima = 0.1;           // mm, t_I of the layer rule
+  double remodeling = 0.0;               // outward growth of the outer wall per mm of plaque (0: none, 1: full)
   int circumferential_points = 64;
+  double station_spacing = 0.25;         // mm between the wall's sections
+  double flare_ratio = 1.6;              // rays beyond this times r_ref are counted as flared (ostia, flared ends)
+  StenosisRule stenosis;                 // the reference r_ref(s) (set from the case's `stenosis:` section)
 };
+
+/// Reads wall_thickness (length, optional), nominal_intima (length) and
+/// remodeling of an input section (one parser for every input kind).
+WallSynthesisOptions parse_wall_synthesis(ConfigMap& section);
+
+/// The layer rule's wall thickness for a healthy reference lumen diameter.
+double layer_rule_thickness(double reference_diameter, double nominal_intima);
 
 struct SurfaceInput {
   std::filesystem::path lumen;
@@ -79,19 +96,22 @@ struct TreeInput {
   Eigen::Vector3d from = Eigen::Vector3d::Zero();  // mm, inlet (proximal point)
   std::optional<Eigen::Vector3d> to;               // mm; absent: longest path from the inlet
   std::optional<double> roi_length;                // mm around the stenosis; absent: the whole segment
+  std::optional<double> roi_center;                // mm along the extracted segment; absent: the most severe lesion
   bool repair = true;
   WallSynthesisOptions synthesis;
 };
 
 /// Reads an `input.tree:` section: file, units, from ([x, y, z] in mm), to
 /// ([x, y, z] in mm) or longest_path_from_inlet: true, roi_length (length,
-/// optional), repair, wall_thickness, remodeling. Calls section.finish().
+/// optional), roi_center (length along the segment, optional), repair,
+/// wall_thickness, nominal_intima, remodeling. Calls section.finish().
 TreeInput parse_tree_input(ConfigMap& section);
 
 /// What an `input:` section holds: exactly one of `phantom:`, `surface:`,
 /// `simvascular:`, `label_image:` or `tree:`.
 struct SegmentationInput {
   std::variant<PhantomSpec, SurfaceInput, SimVascularInput, LabelImageInput, TreeInput> source;
+  StenosisRule stenosis;  // the case's `stenosis:` section (region of interest, wall synthesis)
   bool is_phantom() const { return std::holds_alternative<PhantomSpec>(source); }
   /// The user's files the stage reads (external inputs: editing one makes the stage stale).
   std::vector<std::filesystem::path> input_files() const;
@@ -111,6 +131,17 @@ TriSurface load_checked_surface(const std::filesystem::path& file, const Surface
                                 SurfaceReport& report);
 
 /// The synthesized outer wall for a lumen (open tube, outward normals).
-TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& options);
+/// Summary: wall_thickness_min/max/reference, the fractions of missing and
+/// flared rays, wall_min_clearance_ratio (smallest wall-to-lumen distance
+/// over t, checked on planes between the sections). InputError when the wall
+/// comes closer to the lumen than t/2 there.
+/// `centerline`: the lumen's centerline when the caller has it (computed
+/// with options.stenosis), else computed here.
+TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& options, Summary& summary,
+                           const CenterlineResult* centerline = nullptr);
+
+/// Twice the stenosis rule's reference radius at the middle of its analysed
+/// range: the vessel's robust healthy diameter (the units rule's measure).
+double robust_reference_diameter(const StenosisProfile& p);
 
 }  // namespace stentsim::segmentation

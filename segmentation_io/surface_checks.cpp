@@ -87,10 +87,8 @@ TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& o, const st
   for (auto& p : s.points) p *= scale;
   const double diag = bounding_box_diagonal(s);
   if (diag < o.min_size || diag > o.max_size) {
-    std::string hint;
-    if (diag * 1000 >= o.min_size && diag * 1000 <= o.max_size) hint = "; the file looks like it is in metres: set units: m";
-    else if (diag * 10 >= o.min_size && diag * 10 <= o.max_size) hint = "; the file looks like it is in centimetres: set units: cm";
-    else if (diag / 1000 >= o.min_size && diag / 1000 <= o.max_size) hint = "; the file looks like it is in micrometres: set units: um";
+    const std::string u = likely_units(diag, o.units, o.min_size, o.max_size);
+    const std::string hint = u.empty() ? "" : fmt::format("; the file looks like it is in {}: set units: {}", unit_word(u), u);
     fail(fmt::format("the surface spans {:.4g} mm (bounding-box diagonal) with units '{}', but a coronary segment spans "
                      "{:g} to {:g} mm{}", diag, o.units, o.min_size, o.max_size, hint));
   }
@@ -285,6 +283,31 @@ TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& o, const st
     }
   s.points = std::move(used);
   return s;
+}
+
+std::string unit_word(const std::string& u) {
+  return u == "mm" ? "millimetres" : u == "cm" ? "centimetres" : u == "m" ? "metres" : u == "um" ? "micrometres" : u;
+}
+
+std::string likely_units(double value_mm, const std::string& declared, double lo_mm, double hi_mm) {
+  const double in_file = value_mm / unit_length_in_mm(declared);
+  for (const char* u : {"mm", "cm", "m", "um"}) {
+    if (u == declared) continue;
+    const double v = in_file * unit_length_in_mm(u);
+    if (v >= lo_mm && v <= hi_mm) return u;
+  }
+  return "";
+}
+
+void check_reference_diameter_units(double d, const std::string& declared, const std::string& what,
+                                    const std::string& units_key) {
+  if (d >= kMinReferenceDiameter && d <= kMaxReferenceDiameter) return;
+  const std::string u = likely_units(d, declared, kMinReferenceDiameter, kMaxReferenceDiameter);
+  throw InputError(fmt::format(
+      "{}: the lumen's reference diameter is {:.4g} mm with {}: {}, but a coronary lumen's is about {:g} to {:g} mm{}",
+      what, d, units_key, declared, kMinReferenceDiameter, kMaxReferenceDiameter,
+      u.empty() ? fmt::format("; check the file's units ({}) or the region of interest", units_key)
+                : fmt::format("; the file looks like it is in {}: set {}: {}", unit_word(u), units_key, u)));
 }
 
 }  // namespace stentsim::segmentation

@@ -17,6 +17,26 @@ TriSurface read_surface_file(const std::filesystem::path& file);
 /// Length of one file unit in mm for "mm", "cm", "m", "um"; InputError otherwise.
 double unit_length_in_mm(const std::string& unit);
 
+/// The one units rule: a length measured as `value_mm` with the file read in
+/// `declared` units lies outside [lo_mm, hi_mm]. Returns the other units in
+/// which the same file value would fall inside (e.g. "cm": ×10 fits and ×1
+/// does not), or "" when none does.
+std::string likely_units(double value_mm, const std::string& declared, double lo_mm, double hi_mm);
+
+/// "millimetres", "centimetres", "metres", "micrometres" for mm, cm, m, um.
+std::string unit_word(const std::string& unit);
+
+/// The plausible healthy reference lumen diameter of a coronary artery, mm.
+inline constexpr double kMinReferenceDiameter = 1.5, kMaxReferenceDiameter = 8.0;
+
+/// InputError when the lumen's robust reference diameter (twice the stenosis
+/// rule's reference radius, median over the analysed range; not the minimal
+/// one: a 70 % lesion is below 1 mm) is outside 1.5–8 mm, naming `what` (the
+/// file), the diameter, the declared units and, where one fits, the setting
+/// `units_key` and its likely value.
+void check_reference_diameter_units(double reference_diameter_mm, const std::string& declared, const std::string& what,
+                                    const std::string& units_key);
+
 struct SurfaceCheckOptions {
   std::string units = "mm";           // units of the file's coordinates
   bool repair = true;                  // false: every defect is an error

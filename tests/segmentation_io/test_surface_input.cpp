@@ -348,7 +348,8 @@ TEST(WallSynthesis, OuterRadiusAtTheThroatFollowsTheReferenceRule) {
     WallSynthesisOptions o;
     o.wall_thickness = t;
     o.remodeling = m;
-    const double R = outer_radius_at_throat(synthesize_wall(lumen, o));
+    Summary summary;
+    const double R = outer_radius_at_throat(synthesize_wall(lumen, o, summary));
     const double expected = Rref + t + m * (Rref - r_throat);
     std::printf("remodeling %.1f: outer radius at the throat %.4f mm, expected %.4f mm (%.2f %%)\n", m, R, expected,
                 100 * (R / expected - 1));
