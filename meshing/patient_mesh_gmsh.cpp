@@ -13,6 +13,7 @@
 #include <set>
 
 #include "common/error.hpp"
+#include "common/log.hpp"
 #include "common/mesh_tags.hpp"
 #include "meshing/patient_mesh.hpp"
 
@@ -31,7 +32,14 @@ struct GmshSession {
     gmsh::option::setNumber("General.NumThreads", 1);
     for (const char* k : {"Mesh.MaxNumThreads1D", "Mesh.MaxNumThreads2D", "Mesh.MaxNumThreads3D"}) gmsh::option::setNumber(k, 1);
   }
-  ~GmshSession() { gmsh::finalize(); }
+  // gmsh::finalize may throw (a std::string in gmsh 4.8); from a destructor
+  // during unwinding that would terminate the process.
+  ~GmshSession() {
+    try {
+      gmsh::finalize();
+    } catch (...) {
+    }
+  }
 };
 
 /// Nearest station and ray of a point: the local layer radii there.
@@ -60,10 +68,9 @@ struct SectionLookup {
 
 }  // namespace
 
-MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh) {
-  validate(o);
-  check_wall_sections(w, o.min_section_gap_ratio);
-  check_layer_sizing(w, o);
+namespace {
+
+MeshData mesh_with_gmsh(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh) {
   GmshSession session;
   namespace occ = gmsh::model::occ;
   gmsh::model::add("artery");
@@ -201,8 +208,21 @@ MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, 
   gmsh::option::setNumber("Mesh.Smoothing", 3);
   gmsh::option::setNumber("Mesh.ElementOrder", o.element == "tet10" ? 2 : 1);
   gmsh::option::setNumber("Mesh.SecondOrderLinear", 1);  // midside nodes on straight edges: projecting them onto the lofted B-spline faces took > 10 min on case2-rca
+  // gmsh's API default (AbortOnError 2) throws a std::string from Msg::Error;
+  // thrown inside the mesher's OpenMP regions it cannot be caught and
+  // terminates the process (seen on a real vessel). 1: an error aborts the
+  // meshing, the call returns, and the error is read from the logger.
+  gmsh::option::setNumber("General.AbortOnError", 1);
+  gmsh::logger::start();
   try {
     gmsh::model::mesh::generate(3);
+    std::string last;
+    gmsh::logger::getLastError(last);
+    if (!last.empty())
+      throw ComputeError(fmt::format("mesh: gmsh failed to mesh the layers ({}); try a smaller mesh.size or a larger "
+                                     "mesh.min_intima", last));
+  } catch (const ComputeError&) {
+    throw;
   } catch (const std::exception& e) {
     throw ComputeError(fmt::format("mesh: gmsh failed: {}", e.what()));
   } catch (...) {
@@ -285,6 +305,40 @@ MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, 
   m.field_text["description"] = fmt::format("patient artery wall: {} layers, {} (gmsh OCC loft of {} sections)",
                                             w.layers.size(), o.element, ns);
   return m;
+}
+
+}  // namespace
+
+MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh) {
+  validate(o);
+  check_wall_sections(w, o.min_section_gap_ratio);
+  check_layer_sizing(w, o);
+  log::info("mesh: lofting {} sections of {} surfaces and meshing them with gmsh ({}, size {} mm)", w.origin.size(),
+            w.radius.empty() ? 0 : w.radius[0].size(), o.element, o.size);
+  // gmsh 4.8 reports some failures (OCC lofts and booleans, tetgen's boundary
+  // recovery) by throwing a std::string or other non-std objects: each
+  // becomes a ComputeError with gmsh's last message instead of a terminate.
+  auto failed = [](const std::string& what) {
+    std::string last;
+    try {
+      gmsh::logger::getLastError(last);
+    } catch (...) {
+    }
+    return ComputeError(fmt::format("mesh: gmsh failed ({}{}{}); try a smaller mesh.size, a larger mesh.min_intima or "
+                                    "a smaller region of interest",
+                                    what, last.empty() ? "" : ": ", last));
+  };
+  try {
+    return mesh_with_gmsh(w, o, msh);
+  } catch (const std::exception&) {
+    throw;
+  } catch (const std::string& e) {
+    throw failed(e);
+  } catch (const char* e) {
+    throw failed(e);
+  } catch (...) {
+    throw failed("no message");
+  }
 }
 
 }  // namespace stentsim::meshing
