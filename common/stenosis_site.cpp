@@ -21,6 +21,7 @@ StenosisRule parse_stenosis_rule(ConfigMap& m) {
   r.merge_distance = m.quantity("merge_distance", units::kLength, r.merge_distance, Range::non_negative());
   r.end_exclusion_diameters = m.number("end_exclusion_diameters", r.end_exclusion_diameters, Range::between(0, 20));
   r.smoothing_window = m.quantity("smoothing_window", units::kLength, r.smoothing_window, Range::non_negative());
+  r.reference_window = m.quantity("reference_window", units::kLength, r.reference_window, Range{0.0, 1e6, false, true});
   m.finish();
   return r;
 }
@@ -82,23 +83,6 @@ std::vector<double> smoothed(const std::vector<double>& S, const std::vector<dou
 
 }  // namespace
 
-TaperedStenosis stenosis_discounting_taper(const std::vector<double>& S, const std::vector<double>& R, double lo,
-                                           double hi) {
-  const std::vector<std::size_t> inner = samples_between(S, std::min(S.size(), R.size()), lo, hi);
-  if (inner.size() < 3) throw ComputeError("stenosis site: fewer than three centerline samples between the ends");
-  const Line l = envelope_line(S, R, inner);
-  TaperedStenosis t;
-  t.slope = l.b;
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t i : inner) {
-    const double ref = l.a + l.b * S[i];
-    if (ref <= 0) continue;
-    if (R[i] / ref < best) best = R[i] / ref, t.abscissa = S[i], t.radius = R[i], t.reference_radius = ref;
-  }
-  if (!std::isfinite(best)) throw ComputeError("stenosis site: the fitted reference radius is not positive");
-  return t;
-}
-
 StenosisProfile analyse_stenoses(const std::vector<double>& S, const std::vector<double>& Rraw, const StenosisRule& rule) {
   const std::size_t n = std::min(S.size(), Rraw.size());
   if (n < 3) throw ComputeError("stenosis rule: fewer than three centerline samples");
@@ -114,15 +98,30 @@ StenosisProfile analyse_stenoses(const std::vector<double>& S, const std::vector
     const double lo = S.front() + 2 * rule.end_exclusion_diameters * std::max(0.0, l.a + l.b * S.front());
     const double hi = S[n - 1] - 2 * rule.end_exclusion_diameters * std::max(0.0, l.a + l.b * S[n - 1]);
     const auto inner = samples_between(S, n, lo, hi);
-    if (inner.size() < 3)
-      throw ComputeError(fmt::format("stenosis rule: the centerline ({:.3g} mm) is shorter than its two excluded ends "
-                                     "({:g} reference diameter(s) each, stenosis.end_exclusion_diameters)",
-                                     S[n - 1] - S.front(), rule.end_exclusion_diameters));
+    if (inner.size() < 3) {
+      // Shorter than its two excluded ends: every sample is looked at, and
+      // the profile (and summary) says so.
+      p.lo = S.front(), p.hi = S[n - 1], p.ends_excluded = false;
+      l = envelope_line(S, R, samples_between(S, n, p.lo, p.hi));
+      break;
+    }
     p.lo = lo, p.hi = hi;
     l = envelope_line(S, R, inner);
   }
   p.intercept = l.a, p.slope = l.b;
   const auto inner = samples_between(S, n, p.lo, p.hi);
+  // Local fits where the analysed range is longer than the window (each
+  // point's line over the window about it, clipped to the range); outside
+  // the range the nearest end's value.
+  if (p.hi - p.lo > rule.reference_window) {
+    for (std::size_t i : inner) {
+      const double c = std::clamp(S[i], p.lo + 0.5 * rule.reference_window, p.hi - 0.5 * rule.reference_window);
+      const auto window = samples_between(S, n, c - 0.5 * rule.reference_window, c + 0.5 * rule.reference_window);
+      const Line w = window.size() >= 3 ? envelope_line(S, R, window) : l;
+      p.ref_s.push_back(S[i]);
+      p.ref_r.push_back(w.a + w.b * S[i]);
+    }
+  }
   std::vector<double> depth(n, 0.0);  // percent diameter stenosis of the smoothed radius
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i : inner) {
@@ -145,10 +144,20 @@ StenosisProfile analyse_stenoses(const std::vector<double>& S, const std::vector
     std::size_t a = i, b = j;
     while (a > first && depth[a] > recovered) --a;
     while (b < last && depth[b] > recovered) ++b;
-    const bool ok = depth[a] <= recovered && depth[b] <= recovered;
+    // And the lumen widens again on both sides: the radius at each end of
+    // the extent rises above the extent's smallest by what the recovery
+    // means against a flat reference, (1 - recovery_fraction) of the
+    // threshold. A step down at a branch (the reference, fitted over a
+    // window, sits high just beyond it) has no distal rise and is no lesion.
+    double rmin = std::numeric_limits<double>::infinity(), ref_min = 0;
+    for (std::size_t k = a; k <= b; ++k)
+      if (R[k] < rmin) rmin = R[k], ref_min = p.reference_at(S[k]);
+    const double rise = (1 - rule.recovery_fraction) * rule.threshold_percent / 100 * ref_min;
+    const bool ok = depth[a] <= recovered && depth[b] <= recovered && R[a] - rmin >= rise && R[b] - rmin >= rise;
     if (ok) {
       Lesion les;
-      les.start = S[a], les.end = S[b], les.slope = l.b;
+      les.start = S[a], les.end = S[b];
+      les.slope = (p.reference_at(S[b]) - p.reference_at(S[a])) / std::max(1e-12, S[b] - S[a]);
       // Found on the smoothed radius, measured on the raw one: the narrowest
       // raw r / r_ref inside the extent.
       double worst = std::numeric_limits<double>::infinity();
@@ -184,6 +193,15 @@ StenosisProfile analyse_stenoses(const std::vector<double>& S, const std::vector
   return p;
 }
 
+double StenosisProfile::reference_at(double s) const {
+  if (ref_s.empty()) return intercept + slope * s;
+  if (s <= ref_s.front()) return ref_r.front();
+  if (s >= ref_s.back()) return ref_r.back();
+  const std::size_t j = std::size_t(std::upper_bound(ref_s.begin(), ref_s.end(), s) - ref_s.begin());
+  const double f = (s - ref_s[j - 1]) / std::max(1e-12, ref_s[j] - ref_s[j - 1]);
+  return (1 - f) * ref_r[j - 1] + f * ref_r[j];
+}
+
 const Lesion* StenosisProfile::most_severe() const {
   const Lesion* best = nullptr;
   for (const Lesion& l : lesions)
@@ -213,13 +231,19 @@ void report_lesions(const StenosisProfile& p, Summary& summary, const std::strin
   summary.set(prefix + "reference_radius_intercept", p.intercept, "mm");
   summary.set(prefix + "reference_taper", p.slope);  // dr_ref/ds
   summary.note(prefix + "lesion_rule",
-               fmt::format("narrowing deeper than {:g} % diameter stenosis against a straight reference line fitted to "
-                           "the radius's upper envelope (follows the taper), recovering below {:g} % on both sides; "
+               fmt::format("narrowing deeper than {:g} % diameter stenosis against a reference line fitted to the "
+                           "radius's upper envelope over {:g} mm about each point (follows the taper), recovering below "
+                           "{:g} % on both sides; "
                            "narrowest points closer than {:g} mm merged; ends excluded by {:g} reference diameter(s); "
                            "radius averaged over {:g} mm",
-                           p.rule.threshold_percent, p.rule.recovery_fraction * p.rule.threshold_percent,
+                           p.rule.threshold_percent, p.rule.reference_window,
+                           p.rule.recovery_fraction * p.rule.threshold_percent,
                            p.rule.merge_distance, p.rule.end_exclusion_diameters, p.rule.smoothing_window));
   if (p.lesions.empty()) summary.note(prefix + "lesions", p.no_lesion_message());
+  if (!p.ends_excluded)
+    summary.note(prefix + "lesion_ends", fmt::format("the vessel ({:.3g} mm) is shorter than its two excluded ends "
+                                                     "(stenosis.end_exclusion_diameters): every sample was looked at",
+                                                     p.hi - p.lo));
   for (std::size_t k = 0; k < p.lesions.size(); ++k) {
     const Lesion& l = p.lesions[k];
     const std::string key = fmt::format("{}lesion_{}_", prefix, k + 1);

@@ -28,10 +28,15 @@ struct StenosisRule {
   /// Moving average of the radius over this length before the rule (mm): the
   /// inscribed radius of a triangulated real surface is noisy.
   double smoothing_window = 0.5;
+  /// The reference line is fitted over this length about each point (mm):
+  /// a coronary's taper is not straight over a whole tree path (it steps down
+  /// at each branch), and a lesion shorter than half of it drops out of the fit.
+  double reference_window = 20.0;
 };
 
 /// Reads a `stenosis:` section (threshold_percent, recovery_fraction,
-/// merge_distance, end_exclusion_diameters, smoothing_window); calls finish().
+/// merge_distance, end_exclusion_diameters, smoothing_window,
+/// reference_window); calls finish().
 StenosisRule parse_stenosis_rule(ConfigMap& section);
 
 /// The narrowest point of a tapering vessel relative to its reference line.
@@ -51,18 +56,22 @@ struct Lesion : TaperedStenosis {
   std::optional<std::array<double, 3>> point;  // mm, where the caller knows the curve
 };
 
-/// The healthy reference line r_ref(s) = intercept + slope s and the lesions.
-/// Coronary lumens narrow distally, so the narrowest radius can be a healthy
-/// distal end: the line is fitted by least squares to the upper envelope of
-/// the radius (repeated on the samples at or above the previous line less
-/// 2 % of its mean, so lesions drop out of the fit) and follows the taper.
+/// The healthy reference r_ref(s) and the lesions. Coronary lumens narrow
+/// distally, so the narrowest radius can be a healthy distal end: r_ref is a
+/// line fitted by least squares to the upper envelope of the radius
+/// (repeated on the samples at or above the previous line less 2 % of its
+/// mean, so lesions drop out of the fit) over reference_window about each
+/// point, so it follows the taper; on a vessel no longer than the window it
+/// is one straight line, intercept + slope s.
 struct StenosisProfile {
-  double intercept = 0, slope = 0;
+  double intercept = 0, slope = 0;    // the line over the whole analysed range
+  std::vector<double> ref_s, ref_r;   // r_ref at the samples (local fits); empty: the line
   double lo = 0, hi = 0;              // the analysed range (ends excluded), mm
+  bool ends_excluded = true;          // false: shorter than its excluded ends, every sample analysed
   std::vector<Lesion> lesions;        // in order of abscissa
   TaperedStenosis narrowest;          // smallest r / r_ref in [lo, hi], a lesion or not
   StenosisRule rule;
-  double reference_at(double s) const { return intercept + slope * s; }
+  double reference_at(double s) const;
   /// The deepest lesion (largest percent diameter stenosis); nullptr when none.
   const Lesion* most_severe() const;
   /// The lesion whose extent holds s, else the one whose narrowest point is
@@ -72,9 +81,10 @@ struct StenosisProfile {
   std::string no_lesion_message() const;
 };
 
-/// The rule on samples of radius R at abscissae S (increasing). Throws
-/// ComputeError with fewer than three samples, or fewer than three left once
-/// the ends are excluded, or a non-positive reference line.
+/// The rule on samples of radius R at abscissae S (increasing). A vessel
+/// shorter than its two excluded ends is analysed whole (ends_excluded
+/// false). Throws ComputeError with fewer than three samples or a
+/// non-positive reference line.
 StenosisProfile analyse_stenoses(const std::vector<double>& S, const std::vector<double>& R, const StenosisRule& rule = {});
 
 /// Writes lesion_count and lesion_<k>_{abscissa, point, min_radius,
@@ -82,12 +92,5 @@ StenosisProfile analyse_stenoses(const std::vector<double>& S, const std::vector
 /// by abscissa), the reference line and the rule into `summary`, with
 /// `prefix` before every key (e.g. "roi_").
 void report_lesions(const StenosisProfile& p, Summary& summary, const std::string& prefix = "");
-
-/// The upper-envelope fit and narrowest point alone, between lo and hi (no
-/// smoothing, no end rule): the building block of analyse_stenoses.
-/// Throws ComputeError with fewer than three samples in [lo, hi] or a
-/// non-positive reference line there.
-TaperedStenosis stenosis_discounting_taper(const std::vector<double>& abscissa, const std::vector<double>& radius,
-                                           double lo, double hi);
 
 }  // namespace stentsim

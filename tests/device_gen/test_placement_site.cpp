@@ -265,9 +265,10 @@ TEST(DeviceGenPlacementSite, TaperingVesselStenosisMidVesselNotTheDistalEnd) {
   EXPECT_NEAR(P.percent_diameter_stenosis(), expected_pct, 0.1);
   // The same rule as the segmentation ROI: the shared function on the raw
   // radius gives the same site.
-  const TaperedStenosis raw = stenosis_discounting_taper(cl.abscissa, cl.radius, 1.0, 29.0);
-  EXPECT_NEAR(raw.abscissa, P.site_abscissa, 0.5 * kSample);
-  EXPECT_NEAR(raw.percent_diameter(), 30.0, 0.1);
+  const StenosisProfile prof = analyse_stenoses(cl.abscissa, cl.radius);
+  ASSERT_NE(prof.most_severe(), nullptr);
+  EXPECT_NEAR(prof.most_severe()->abscissa, P.site_abscissa, 0.5 * kSample);
+  EXPECT_NEAR(prof.most_severe()->percent_diameter(), 30.0, 0.1);
 
   // summary.yaml and placement.yaml carry the same site and percent stenosis.
   const fs::path dir = temp_dir("taper");

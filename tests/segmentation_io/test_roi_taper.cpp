@@ -77,9 +77,11 @@ TEST(RoiTaper, SiteDiscountsTheTaper) {
   for (std::size_t i = 0; i < S.size(); ++i)
     if (S[i] >= 1.0 && S[i] <= 19.0 && R[i] < R[imin]) imin = i;
   EXPECT_NEAR(S[imin], 19.0, 1e-9);
-  const TaperedStenosis t = stenosis_discounting_taper(S, R, 1.0, 19.0);
-  std::printf("taper-discounted site %.3f mm (true 6), r %.4f, r_ref %.4f (true %.4f), slope %.4f (true -0.06), %.2f %% "
-              "(true 30)\n", t.abscissa, t.radius, t.reference_radius, healthy(6.0), t.slope, t.percent_diameter());
+  const StenosisProfile prof = analyse_stenoses(S, R);
+  ASSERT_EQ(prof.lesions.size(), 1u);
+  const Lesion& t = prof.lesions[0];
+  std::printf("lesion %.3f mm (true 6), r %.4f, r_ref %.4f (true %.4f), slope %.4f (true -0.06), %.2f %% (true 30)\n",
+              t.abscissa, t.radius, t.reference_radius, healthy(6.0), t.slope, t.percent_diameter());
   EXPECT_NEAR(t.abscissa, 6.0, 0.11);
   EXPECT_NEAR(t.slope, -0.06, 0.003);
   EXPECT_NEAR(t.reference_radius, healthy(6.0), 0.02 * healthy(6.0));
@@ -87,8 +89,9 @@ TEST(RoiTaper, SiteDiscountsTheTaper) {
   // Without taper the same rule finds the same site as the raw minimum.
   std::vector<double> flat(R.size());
   for (std::size_t i = 0; i < S.size(); ++i) flat[i] = R[i] / healthy(S[i]) * 1.5;
-  EXPECT_NEAR(stenosis_discounting_taper(S, flat, 1.0, 19.0).abscissa, 6.0, 0.11);
-  EXPECT_THROW(stenosis_discounting_taper(S, R, 30.0, 40.0), ComputeError);
+  ASSERT_NE(analyse_stenoses(S, flat).most_severe(), nullptr);
+  EXPECT_NEAR(analyse_stenoses(S, flat).most_severe()->abscissa, 6.0, 0.11);
+  EXPECT_THROW(analyse_stenoses({0.0, 1.0}, {1.0, 1.0}), ComputeError);
 }
 
 TEST(RoiTaper, RegionOfInterestIsCentredOnTheStenosisNotTheDistalEnd) {
