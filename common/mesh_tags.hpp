@@ -7,6 +7,9 @@ namespace stentsim::tags {
 
 inline constexpr const char* kLayer = "Layer";
 inline constexpr const char* kFaceGroup = "FaceGroup";
+/// Field of lumen.vtp (text "x y z", mm): the lesion a tree's region of
+/// interest is centred on (segmentation); the placement treats the lesion there.
+inline constexpr const char* kTreatedSite = "treated_site_point";
 
 enum Layer : int { no_layer = 0, intima = 1, media = 2, adventitia = 3, balloon_wall = 4 };
 

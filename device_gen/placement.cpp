@@ -6,10 +6,12 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <sstream>
 
 #include "common/config.hpp"
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "common/mesh_tags.hpp"
 #include "common/stenosis_site.hpp"
 #include "common/units.hpp"
 #include "device_gen/surface_distance.hpp"
@@ -53,9 +55,10 @@ Placement compute_placement(const PlacementParams& prm, const Centerline& cl, co
                                  P.balloon_length));
   const double L = balloon.length;
 
-  // 1. The site: given, or the most severe lesion by the stenosis rule
-  // (common/stenosis_site, as the centerline stage and the segmentation's
-  // region of interest); a vessel with no lesion needs a given site.
+  // 1. The site: given; else the lesion a tree's region of interest was
+  // centred on (lumen.vtp names it); else the most severe lesion by the
+  // stenosis rule (common/stenosis_site, as the centerline stage and the
+  // segmentation's region of interest). A vessel with no lesion needs a site.
   std::optional<StenosisProfile> prof;
   try {
     prof = analyse_stenoses(cl.abscissa, cl.radius, prm.stenosis);
@@ -70,6 +73,18 @@ Placement compute_placement(const PlacementParams& prm, const Centerline& cl, co
     if (P.site_abscissa < cl.begin() || P.site_abscissa > cl.end())
       throw InputError(fmt::format("placement: site_abscissa {} mm lies outside the centerline of {} ({} to {} mm)",
                                    P.site_abscissa, cl.source, cl.begin(), cl.end()));
+  } else if (lumen && lumen->field_text.count(tags::kTreatedSite)) {
+    // The segmentation centred its region of interest on a lesion (the tree's
+    // roi_center or its most severe one): the lesion nearest that point.
+    Eigen::Vector3d x;
+    std::istringstream in(lumen->field_text.at(tags::kTreatedSite));
+    in >> x.x() >> x.y() >> x.z();
+    double at = cl.begin(), best = std::numeric_limits<double>::infinity();
+    for (double sv : cl.abscissa)
+      if ((cl.point_at(sv) - x).norm() < best) best = (cl.point_at(sv) - x).norm(), at = sv;
+    const Lesion* lesion = prof->nearest(at);
+    P.site_abscissa = lesion && at >= lesion->start && at <= lesion->end ? lesion->abscissa : at;
+    P.site_chosen_by = "the region of interest's lesion";
   } else {
     const Lesion* lesion = prof->most_severe();
     if (!lesion)

@@ -4,6 +4,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "common/mesh_tags.hpp"
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/label_image.hpp"
 #include "segmentation_io/simvascular_io.hpp"
@@ -11,6 +12,26 @@
 #include "segmentation_io/tree_input.hpp"
 
 namespace stentsim::segmentation {
+
+/// A sample of the lumen's points (not its end rings, which lie in the cut
+/// planes where the capped wall's caps are too) must lie inside the wall.
+void check_wall_encloses_lumen(const TriSurface& lumen, const TriSurface& wall, const std::string& lumen_name,
+                               const std::string& wall_what) {
+  TriSurface closed = capped(wall, boundary_loops(wall));
+  std::vector<char> on_end(lumen.points.size(), 0);
+  for (const auto& loop : boundary_loops(lumen))
+    for (int v : loop.vertices) on_end[std::size_t(v)] = 1;
+  std::vector<Eigen::Vector3d> sample;
+  std::size_t step = std::max<std::size_t>(1, lumen.points.size() / 500);
+  for (std::size_t i = 0; i < lumen.points.size(); i += step)
+    if (!on_end[i]) sample.push_back(lumen.points[i]);
+  auto inside = inside_closed_surface(closed, sample);
+  std::size_t outside = std::count(inside.begin(), inside.end(), false);
+  // Points on the cut planes may sit on the wall's caps: allow a few.
+  if (outside > sample.size() / 50)
+    throw InputError(fmt::format("{}: {} of {} sampled lumen points lie outside {}", lumen_name, outside,
+                                 sample.size(), wall_what));
+}
 
 double robust_reference_diameter(const StenosisProfile& p) { return 2 * p.reference_at(0.5 * (p.lo + p.hi)); }
 
@@ -197,6 +218,7 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
   // Lumen and optional wall as raw surfaces in the files' units, then the
   // same checks, repairs and wall synthesis for every kind of input.
   TriSurface lumen_raw, wall_raw;
+  std::optional<Eigen::Vector3d> roi_site;  // the lesion a tree's region of interest is centred on
   bool have_wall = false;
   std::string lumen_name, wall_name, kind;
   SurfaceCheckOptions checks;
@@ -267,6 +289,14 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
       summary.set("roi_stenosis_abscissa", site.abscissa, "mm");
       summary.set("roi_stenosis_percent_diameter", site.percent_diameter(), "%");
       summary.note("roi_centre", tr->roi_center ? "input.tree.roi_center" : "the most severe lesion of the segment");
+      // The lesion the region was centred on, for the placement (whose
+      // centerline's abscissae start again at the region's end).
+      const auto& P = seg.centerline.centerline.points;
+      const auto& S = seg.centerline.centerline.point_data.at("Abscissas").values;
+      const std::size_t k = std::min<std::size_t>(
+          P.size() - 1, std::size_t(std::lower_bound(S.begin(), S.end(), site.abscissa) - S.begin()));
+      roi_site = P[k];
+      summary.set("roi_site_point", std::vector<double>{P[k].x(), P[k].y(), P[k].z()}, "mm");
       report_lesions(profile, summary, "tree_");  // along the whole extracted segment
     }
     lumen_name = tr->file.string() + " (extracted segment)";
@@ -303,33 +333,23 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     SurfaceReport wr;
     wall = check_and_repair(std::move(wall_raw), checks, wall_name, wr);
     report_to_summary("wall", wr, summary);
-    // The wall must enclose the lumen: a sample of lumen points must lie inside it.
-    auto wl = boundary_loops(wall);
-    TriSurface closed = capped(wall, wl);
-    // The lumen's own end rings lie in the cut planes, where the wall's caps
-    // are too (inside/outside is ambiguous there): they are not sampled.
-    std::vector<char> on_end(lumen.points.size(), 0);
-    for (const auto& loop : boundary_loops(lumen))
-      for (int v : loop.vertices) on_end[std::size_t(v)] = 1;
-    std::vector<Eigen::Vector3d> sample;
-    std::size_t step = std::max<std::size_t>(1, lumen.points.size() / 500);
-    for (std::size_t i = 0; i < lumen.points.size(); i += step)
-      if (!on_end[i]) sample.push_back(lumen.points[i]);
-    auto inside = inside_closed_surface(closed, sample);
-    std::size_t outside = std::count(inside.begin(), inside.end(), false);
-    // Points on the cut planes may sit on the wall's caps: allow a few.
-    if (outside > sample.size() / 50)
-      throw InputError(fmt::format("{}: {} of {} sampled lumen points lie outside the wall surface {}; is the wall the "
-                                   "outer surface of the same vessel, in the same units?",
-                                   lumen_name, outside, sample.size(), wall_name));
+    check_wall_encloses_lumen(lumen, wall, lumen_name,
+                              "the wall surface " + wall_name + "; is the wall the outer surface of the same vessel, in the same units?");
     summary.set_text("wall_source", "file");
   } else {
     synthesis.stenosis = input.stenosis;
+    synthesis.remedy = kind == "tree"        ? "move the region of interest (input.tree.roi_center, input.tree.roi_length)"
+                       : kind == "surface"   ? "give the outer wall (input.surface.wall)"
+                       : kind == "simvascular" ? "give the outer wall's contours (input.simvascular.wall)"
+                                               : "label the wall in the image (input.label_image.wall_label)";
     wall = synthesize_wall(lumen, synthesis, summary, &lumen_centerline);
+    check_wall_encloses_lumen(lumen, wall, lumen_name, "the wall synthesized from it; " + synthesis.remedy);
     summary.set_text("wall_source", "synthesized from the lumen");
     summary.set("wall_remodeling", synthesis.remodeling);
   }
-  write_vtp(out_lumen_vtp.string(), to_output(lumen, lumen_name));
+  MeshData lumen_out = to_output(lumen, lumen_name);
+  if (roi_site) lumen_out.field_text[tags::kTreatedSite] = fmt::format("{:.17g} {:.17g} {:.17g}", roi_site->x(), roi_site->y(), roi_site->z());
+  write_vtp(out_lumen_vtp.string(), lumen_out);
   write_vtp(out_wall_vtp.string(), to_output(wall, have_wall ? wall_name : "synthesized"));
   summary.set_text("input", kind);
   summary.set("lumen_triangles", double(lumen.num_triangles()));

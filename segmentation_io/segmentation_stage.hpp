@@ -32,6 +32,8 @@ struct WallSynthesisOptions {
   double station_spacing = 0.25;         // mm between the wall's sections
   double flare_ratio = 1.6;              // rays beyond this times r_ref are counted as flared (ostia, flared ends)
   StenosisRule stenosis;                 // the reference r_ref(s) (set from the case's `stenosis:` section)
+  /// What the user can change when the wall cannot be built (set by the stage for its input kind).
+  std::string remedy = "give the outer wall as a file";
 };
 
 /// Reads wall_thickness (length, optional), nominal_intima (length) and

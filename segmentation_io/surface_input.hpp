@@ -30,8 +30,8 @@ std::string unit_word(const std::string& unit);
 inline constexpr double kMinReferenceDiameter = 1.5, kMaxReferenceDiameter = 8.0;
 
 /// InputError when the lumen's robust reference diameter (twice the stenosis
-/// rule's reference radius, median over the analysed range; not the minimal
-/// one: a 70 % lesion is below 1 mm) is outside 1.5–8 mm, naming `what` (the
+/// rule's reference radius at the middle of its analysed range; not the
+/// minimal one: a 70 % lesion is below 1 mm) is outside 1.5–8 mm, naming `what` (the
 /// file), the diameter, the declared units and, where one fits, the setting
 /// `units_key` and its likely value.
 void check_reference_diameter_units(double reference_diameter_mm, const std::string& declared, const std::string& what,

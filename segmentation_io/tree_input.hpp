@@ -24,7 +24,8 @@ Eigen::Vector3d farthest_point_along_surface(const TriSurface& tree, const Eigen
 /// of `centerline`) the lesion that spans it, or that abscissa itself; else
 /// the most severe lesion by the stenosis rule (common/stenosis_site); with no lesion and no
 /// center, an InputError that says so and names input.tree.roi_center. The
-/// window is shifted to stay inside the rule's analysed range. `s0`, `s1`
+/// window is shifted to keep its cut planes a reference radius inside the
+/// segment's ends. `s0`, `s1`
 /// receive the kept abscissae, `profile` (when given) the rule's result and
 /// `site` the lesion it is centred on. InputError when the segment is shorter
 /// than `length`.

@@ -140,7 +140,7 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
   std::size_t missing = 0, flared = 0;
   auto contour = [&](std::size_t i) {
     const auto cut = plane_cut(lumen_mesh, pts[i], f.tangent[i], f.normal[i], f.binormal[i]);
-    std::vector<double> out(std::size_t(N));
+    std::vector<double> out(static_cast<std::size_t>(N));
     for (int j = 0; j < N; ++j) {
       const double a = 2 * kPi * j / N;
       const double v = ray_hit(cut, Vector2d(std::cos(a), std::sin(a)));
@@ -187,14 +187,15 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
     }
   }
 
-  // 2. The healthy reference contour: the lumen's contour inflated about the
-  // centerline by k = R* / r, r the inscribed radius and R* = r_ref +
-  // m (r_ref - r)₊ the reference size (m: remodeling), k >= 1, so a healthy or
-  // oval lumen keeps its shape and a stenosed one is widened to the reference
-  // size (the plaque fills the space between). Outside the rule's analysed
-  // range (the excluded ends) the lumen is its own reference. R* is averaged
-  // over ±1 mm so the wall does not step where a lesion begins (R* is linear
-  // in r, so the average does not flatten a throat the way averaging k would).
+  // 2. The healthy reference contour: the lumen's contour united with the
+  // reference circle of radius R* = r_ref + m (r_ref - r)₊ about the
+  // centerline (m: remodeling; r the inscribed radius). The reference line is
+  // fitted to the inscribed radius, so a healthy or oval lumen (every ray at
+  // least its inscribed radius) keeps its own shape, while a stenosed one,
+  // concentric or eccentric, is widened to the reference size and no more
+  // (the plaque fills the space between). Outside the rule's analysed range
+  // (the excluded ends) the lumen is its own reference. R* is averaged over
+  // ±1 mm so the wall does not step where a lesion begins.
   std::vector<std::vector<double>> rstar(ns, std::vector<double>(1, 0.0));
   for (std::size_t k = 0; k < ns; ++k) {
     const std::size_t i = st[k];
@@ -203,17 +204,16 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
     rstar[k][0] = inside ? ref + o.remodeling * std::max(0.0, ref - r[i]) : r[i];
   }
   rstar = smooth_along(rstar, std::max(1, int(std::round(1.0 / h))));
-  std::vector<double> kk(ns);
-  for (std::size_t k = 0; k < ns; ++k) kk[k] = std::max(1.0, rstar[k][0] / std::max(1e-9, r[st[k]]));
+  std::vector<std::vector<double>> reference(ns);
+  for (std::size_t k = 0; k < ns; ++k) {
+    reference[k] = rho[k];
+    for (double& v : reference[k]) v = std::max(v, rstar[k][0]);
+  }
 
   // 3. Dilation by t(s), smoothed along s over ±0.5 mm, never closer to the
   // lumen than 3/4 t.
   std::vector<std::vector<double>> W(ns);
-  for (std::size_t k = 0; k < ns; ++k) {
-    std::vector<double> q = rho[k];
-    for (double& v : q) v *= kk[k];
-    W[k] = dilate(q, thickness_at(st[k]), 4);
-  }
+  for (std::size_t k = 0; k < ns; ++k) W[k] = dilate(reference[k], thickness_at(st[k]), 4);
   W = smooth_along(W, std::max(1, int(std::round(0.5 / h))));
   double tmin = std::numeric_limits<double>::infinity(), tmax = 0;
   for (std::size_t k = 0; k < ns; ++k) {
@@ -221,8 +221,9 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
     for (int j = 0; j < N; ++j) {
       double& w = W[k][std::size_t(j)];
       w = std::max(w, rho[k][std::size_t(j)] + 0.75 * t);
-      tmin = std::min(tmin, w - rho[k][std::size_t(j)]);
-      tmax = std::max(tmax, w - rho[k][std::size_t(j)]);
+      // The wall proper: beyond the reference contour (the plaque is inside it).
+      tmin = std::min(tmin, w - reference[k][std::size_t(j)]);
+      tmax = std::max(tmax, w - reference[k][std::size_t(j)]);
     }
   }
 
@@ -283,9 +284,8 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
     throw InputError(fmt::format(
         "wall (synthesized from the lumen): only {:.3f} mm outside the lumen at s = {:.2f} mm near ({:.3f}, {:.3f}, "
         "{:.3f}), below half the wall thickness {:.3f} mm; the lumen bends or branches too sharply there for sections "
-        "normal to its centerline: choose a region of interest without that site, or give the outer wall (a `wall:` "
-        "file)",
-        worst * where_t, where_s, where.x(), where.y(), where.z(), where_t));
+        "normal to its centerline: {}",
+        worst * where_t, where_s, where.x(), where.y(), where.z(), where_t, o.remedy));
   return wall;
 }
 

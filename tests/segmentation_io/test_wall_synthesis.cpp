@@ -179,6 +179,33 @@ TEST(WallSynthesisShapes, FlaredEndDoesNotInflateTheRestOfTheWall) {
   EXPECT_EQ(lumen_points_outside(lumen, wall, 0.5, L - 0.5), 0u);
 }
 
+// A slit-like lesion (the throat an ellipse of semi-axes 1.2 and 0.6 mm in a
+// 1.5 mm vessel): the wall there is the reference circle dilated by t on
+// every ray, neither following the slit's long axis outward nor scaling the
+// slit up by r_ref / r (which would put its long axis at 3 mm).
+TEST(WallSynthesisShapes, SlitLesionGetsTheReferenceWall) {
+  const double L = 20.0, R0 = 1.5;
+  auto blend = [](double z) {  // 0 healthy .. 1 at the throat (z = 10), over 6 mm
+    const double d = std::abs(z - 10.0);
+    return d < 3.0 ? 0.5 * (1 + std::cos(kPi * d / 3.0)) : 0.0;
+  };
+  const TriSurface lumen = radial_tube(L, [&](double z, double th) {
+    const double a = R0 + (1.2 - R0) * blend(z), b = R0 + (0.6 - R0) * blend(z);
+    return a * b / std::hypot(b * std::cos(th), a * std::sin(th));
+  }, 200, 96);
+  WallSynthesisOptions o;
+  Summary s;
+  const TriSurface wall = synthesize_wall(lumen, o, s);
+  const double t = layer_rule_thickness(2 * R0, o.nominal_intima);
+  double rmin = 1e300, rmax = 0;
+  for (const Vector3d& x : wall.points)
+    if (std::abs(x.z() - 10.0) < 0.2) rmin = std::min(rmin, std::hypot(x.x(), x.y())), rmax = std::max(rmax, std::hypot(x.x(), x.y()));
+  std::printf("slit lesion: wall radius at the throat %.4f .. %.4f mm, expected %.4f (r_ref + t)\n", rmin, rmax, R0 + t);
+  EXPECT_NEAR(rmin, R0 + t, 0.04 * (R0 + t));
+  EXPECT_NEAR(rmax, R0 + t, 0.04 * (R0 + t));
+  EXPECT_EQ(lumen_points_outside(lumen, wall, 0.5, L - 0.5), 0u);
+}
+
 // A fixed wall_thickness overrides the rule.
 TEST(WallSynthesisLayerRule, FixedThicknessOverridesTheRule) {
   const TriSurface lumen = radial_tube(10.0, [](double, double) { return 1.0; });
@@ -199,6 +226,7 @@ TEST(WallSynthesisLayerRule, FixedThicknessOverridesTheRule) {
 TEST(UnitsRule, ReferenceDiameterSaysCentimetresAndTheSettingClearsIt) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / "stentsim_units_rule";
+  fs::remove_all(dir);
   fs::create_directories(dir);
   // 20 mm long, 1.5 mm radius, a 40 % lesion in the middle; coordinates in cm.
   const TriSurface mm = radial_tube(20.0, [](double z, double) {
