@@ -127,6 +127,10 @@ BranchSegment extract_branch(const TriSurface& tree, const Vector3d& a, const Ve
   co.spacing = o.spacing;
   co.source_point = a;
   co.target_point = b;
+  // The side-branch cuts follow the centred Voronoi path itself (the
+  // smoothed curve, which may leave it by a third of a radius, moved a cut
+  // onto a junction's rim: non-manifold caps on the XCAT tree).
+  co.smoothing_length = 0;
   CenterlineResult full = compute_centerline(piece, co);
   const auto& P = full.centerline.points;
   const auto& R = full.centerline.point_data.at("MaximumInscribedSphereRadius").values;

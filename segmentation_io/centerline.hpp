@@ -34,6 +34,12 @@ struct CenterlineOptions {
   /// between the centroids of the two open ends.
   std::optional<Eigen::Vector3d> source_point, target_point;
   int centering_passes = 2;
+  /// Smoothing of the centred path (kinks at lesions and junctions): a
+  /// non-shrinking filter damping wavelengths below about 4 times this length
+  /// (mm; 0: off), each point kept within smoothing_bound × its inscribed
+  /// radius of the path.
+  double smoothing_length = 1.0;
+  double smoothing_bound = 0.3;
   /// Healthy reference radius for the % diameter stenosis; default: the
   /// taper line of common/stenosis_site at the stenosis site.
   std::optional<double> reference_radius;
@@ -45,8 +51,9 @@ struct CenterlineOptions {
 };
 
 /// Reads a `centerline:` section: spacing (length), source/target (3 numbers,
-/// mm, both or neither), centering_passes, reference_radius, true_centerline
-/// (path). Calls section.finish().
+/// mm, both or neither), centering_passes, smoothing_length (length),
+/// smoothing_bound, reference_radius, true_centerline (path). Calls
+/// section.finish().
 CenterlineOptions parse_centerline_options(ConfigMap& section);
 
 struct CenterlineResult {
@@ -63,6 +70,7 @@ struct CenterlineResult {
   double reference_taper = 0;         // dr_ref/ds of the fitted reference line
   double stenosis_percent_diameter = 0;  // 100 (1 − r_min / r_ref)
   std::size_t voronoi_nodes = 0;
+  double smoothing_displacement_max = 0;  // mm, largest move of a point by the smoothing
   double seconds = 0;                 // wall time of compute_centerline
 };
 

@@ -19,6 +19,8 @@ CenterlineOptions parse_centerline_options(ConfigMap& section) {
     o.target_point = Eigen::Vector3d(t[0], t[1], t[2]);
   }
   o.centering_passes = section.integer("centering_passes", 2, Range::between(0, 10));
+  o.smoothing_length = section.quantity("smoothing_length", units::kLength, o.smoothing_length, Range::between(0, 50));
+  o.smoothing_bound = section.number("smoothing_bound", o.smoothing_bound, Range::between(0, 1));
   if (section.has("reference_radius"))
     o.reference_radius = section.quantity("reference_radius", units::kLength, std::nullopt, Range::positive());
   if (section.has("true_centerline")) o.true_centerline = section.path("true_centerline");
@@ -46,6 +48,7 @@ void run_centerline_stage(const CenterlineOptions& options, const std::filesyste
   summary.set("stenosis_percent_diameter", r.stenosis_percent_diameter, "%");
   summary.set("reference_taper", r.reference_taper);  // dr_ref/ds
   summary.set("voronoi_nodes", double(r.voronoi_nodes));
+  summary.set("centerline_smoothing_displacement_max", r.smoothing_displacement_max, "mm");
   summary.set("lumen_triangles", double(lumen.num_cells()));
   summary.set("centerline_time_s", r.seconds, "s");
   summary.note("reference_radius", options.reference_radius ? "given in the case"

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace stentsim::segmentation {
 
@@ -82,6 +83,34 @@ std::vector<Vector3d> resample_polyline(const std::vector<Vector3d>& p, double s
     out.push_back((1 - w) * p[j] + w * p[j + 1]);
   }
   return out;
+}
+
+double smooth_with_bounded_displacement(std::vector<Eigen::Vector3d>& pts, const std::vector<double>& bound,
+                                        double samples) {
+  if (pts.size() < 3) return 0;
+  // Taubin's lambda|mu filter (Taubin 1995, "A signal processing approach to
+  // fair surface design"): a Laplacian step of lambda, then one of mu < 0.
+  // Its pass band ends at k_PB = 1/lambda + 1/mu (k = 1 - cos w for a
+  // frequency of w per sample), here a wavelength of 4 `samples` samples:
+  // kinks (broadband) are smoothed, arcs (low frequency) keep their radius,
+  // which plain Laplacian steps would shrink.
+  const double lambda = 0.5, kpb = 1 - std::cos(std::numbers::pi / std::max(1.0, 8 * samples));
+  const double mu = 1 / (kpb - 1 / lambda);
+  const std::vector<Eigen::Vector3d> raw = pts;
+  const int steps = std::max(1, int(std::lround(8 * samples * samples)));
+  std::vector<Eigen::Vector3d> next = pts;
+  for (int it = 0; it < 2 * steps; ++it) {
+    const double f = it % 2 == 0 ? lambda : mu;
+    for (std::size_t i = 1; i + 1 < pts.size(); ++i) {
+      next[i] = pts[i] + f * (0.5 * (pts[i - 1] + pts[i + 1]) - pts[i]);
+      const Eigen::Vector3d d = next[i] - raw[i];
+      if (d.norm() > bound[i]) next[i] = raw[i] + d * (bound[i] / d.norm());
+    }
+    std::swap(pts, next);
+  }
+  double moved = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) moved = std::max(moved, (pts[i] - raw[i]).norm());
+  return moved;
 }
 
 }  // namespace stentsim::segmentation

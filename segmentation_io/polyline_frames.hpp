@@ -29,4 +29,12 @@ std::vector<double> cumulative_length(const std::vector<Eigen::Vector3d>& pts);
 /// ends (linear interpolation between the given points).
 std::vector<Eigen::Vector3d> resample_polyline(const std::vector<Eigen::Vector3d>& pts, double spacing);
 
+/// Non-shrinking (Taubin lambda|mu) smoothing of a polyline sampled at equal
+/// spacing: wavelengths shorter than about 4 `samples` samples are damped
+/// (2 samples² iterations), longer ones kept; each point stays within
+/// bound[i] of where it started, the ends are fixed. Returns the largest
+/// displacement.
+double smooth_with_bounded_displacement(std::vector<Eigen::Vector3d>& pts, const std::vector<double>& bound,
+                                        double samples);
+
 }  // namespace stentsim::segmentation
