@@ -90,26 +90,61 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
     throw InputError("centerline: point array ParallelTransportNormals (3 components per point) is missing");
   std::vector<double> s(cp.size(), 0.0);
   for (std::size_t i = 1; i < cp.size(); ++i) s[i] = s[i - 1] + (cp[i] - cp[i - 1]).norm();
-  const double L = s.back() - 2 * o.end_trim;
-  if (L < 2 * o.station_spacing)
-    throw InputError(fmt::format("centerline: {:.3g} mm long after end_trim, too short to mesh", L));
-  const int ns = std::max(3, int(std::round(L / o.station_spacing)) + 1);
   WallSections w;
-  const int nk = 2 + (o.intima && (o.media_ratio > 0 || o.adventitia_ratio > 0) ? 1 : 0) +
-                 ((o.media_ratio > 0 && o.adventitia_ratio > 0) ? 1 : 0);
-  if (o.intima) w.layers.push_back(tags::intima);
-  if (o.media_ratio > 0) w.layers.push_back(tags::media);
-  if (o.adventitia_ratio > 0) w.layers.push_back(tags::adventitia);
-  if (int(w.layers.size()) != nk - 1) throw InputError("mesh: inconsistent layer set");
   auto at_abscissa = [&](double sv) {
     const auto it = std::upper_bound(s.begin(), s.end(), sv);
     const std::size_t j = std::clamp<std::size_t>(std::size_t(it - s.begin()), 1, cp.size() - 1);
     const double f = std::clamp((sv - s[j - 1]) / std::max(1e-12, s[j] - s[j - 1]), 0.0, 1.0);
     return Vector3d((1 - f) * cp[j - 1] + f * cp[j]);
   };
+  // Ends cut obliquely to this centerline (a region of interest clipped
+  // normal to the tree path's centerline, a label image's slab): a section
+  // at end_trim may leave the lumen's open end on some rays. The trim at that
+  // end then grows in 0.1 mm steps until the section encloses the centerline
+  // in both surfaces, up to one reference diameter (twice the end's largest
+  // inscribed radius within it); the summary and log give the trims used.
+  const auto radius_it = centerline.point_data.find("MaximumInscribedSphereRadius");
+  auto encloses = [&](double sa) {
+    const Vector3d x = at_abscissa(sa);
+    const Vector3d t = (at_abscissa(std::min(s.back(), sa + 0.5 * o.station_spacing)) -
+                        at_abscissa(std::max(s.front(), sa - 0.5 * o.station_spacing))).normalized();
+    Vector3d n = t.unitOrthogonal(), b = t.cross(n);
+    const auto lc = plane_cut(lumen, x, t, n, b), wc = plane_cut(wall, x, t, n, b);
+    for (int i = 0; i < o.points_per_section; ++i) {
+      const double th = 2 * std::numbers::pi * i / o.points_per_section;
+      const Vector2d dir(std::cos(th), std::sin(th));
+      const double rl = ray_hit(lc, dir), rw = ray_hit(wc, dir);
+      if (std::isnan(rl) || std::isnan(rw) || rw <= rl) return false;
+    }
+    return true;
+  };
+  auto trim_at = [&](bool proximal) {
+    double limit = o.end_trim;
+    if (radius_it != centerline.point_data.end() && radius_it->second.tuples() == cp.size()) {
+      double rmax = 0;  // the end's reference radius: the largest inscribed radius within 5 mm of it
+      for (std::size_t i = 0; i < cp.size(); ++i)
+        if ((proximal ? s[i] - s.front() : s.back() - s[i]) <= 5.0) rmax = std::max(rmax, radius_it->second.values[i]);
+      limit = std::max(limit, 2 * rmax);
+    }
+    for (double trim = o.end_trim; trim <= limit + 1e-9; trim += 0.1)
+      if (encloses(proximal ? s.front() + trim : s.back() - trim)) return trim;
+    return o.end_trim;  // the section loop below reports where and why
+  };
+  w.end_trim_proximal = trim_at(true);
+  w.end_trim_distal = trim_at(false);
+  const double L = s.back() - s.front() - w.end_trim_proximal - w.end_trim_distal;
+  if (L < 2 * o.station_spacing)
+    throw InputError(fmt::format("centerline: {:.3g} mm long after end_trim, too short to mesh", L));
+  const int ns = std::max(3, int(std::round(L / o.station_spacing)) + 1);
+  const int nk = 2 + (o.intima && (o.media_ratio > 0 || o.adventitia_ratio > 0) ? 1 : 0) +
+                 ((o.media_ratio > 0 && o.adventitia_ratio > 0) ? 1 : 0);
+  if (o.intima) w.layers.push_back(tags::intima);
+  if (o.media_ratio > 0) w.layers.push_back(tags::media);
+  if (o.adventitia_ratio > 0) w.layers.push_back(tags::adventitia);
+  if (int(w.layers.size()) != nk - 1) throw InputError("mesh: inconsistent layer set");
   std::size_t seg = 0, clamped = 0, rays = 0;
   for (int st = 0; st < ns; ++st) {
-    const double sa = s.front() + o.end_trim + L * st / (ns - 1);
+    const double sa = s.front() + w.end_trim_proximal + L * st / (ns - 1);
     while (seg + 2 < cp.size() && s[seg + 1] < sa) ++seg;
     const double a = std::clamp((sa - s[seg]) / std::max(1e-12, s[seg + 1] - s[seg]), 0.0, 1.0);
     const Vector3d x = (1 - a) * cp[seg] + a * cp[seg + 1];
@@ -133,7 +168,10 @@ WallSections wall_sections(const MeshData& lumen, const MeshData& wall, const Me
       const double rl = ray_hit(lc, dir), rw = ray_hit(wc, dir);
       const Vector3d where = x + (std::isnan(rl) ? 0.0 : rl) * (std::cos(th) * n + std::sin(th) * b);
       if (std::isnan(rl))
-        throw InputError(fmt::format("lumen: the cross-section at s = {:.2f} mm (point {:.3f} {:.3f} {:.3f}) does not enclose the centerline", sa, x.x(), x.y(), x.z()));
+        throw InputError(fmt::format("lumen: the cross-section at s = {:.2f} mm (point {:.3f} {:.3f} {:.3f}) does not enclose "
+                                     "the centerline{}",
+                                     sa, x.x(), x.y(), x.z(),
+                                     st == 0 || st == ns - 1 ? " (an end cut obliquely: raise mesh.end_trim)" : ""));
       if (std::isnan(rw))
         throw InputError(fmt::format("wall: the cross-section at s = {:.2f} mm (point {:.3f} {:.3f} {:.3f}) does not enclose the centerline", sa, x.x(), x.y(), x.z()));
       if (rw <= rl + 1e-6)
@@ -319,6 +357,11 @@ void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesys
   if (o.element == "tet10") summary.set("min_jacobian_ratio", q.min_jacobian_ratio);
   summary.set("mean_edge_length", q.mean_edge_length, "mm");
   summary.set("sections", double(w.origin.size()));
+  summary.set("end_trim_proximal", w.end_trim_proximal, "mm");
+  summary.set("end_trim_distal", w.end_trim_distal, "mm");
+  if (w.end_trim_proximal > o.end_trim + 1e-9 || w.end_trim_distal > o.end_trim + 1e-9)
+    log::info("mesh: ends cut obliquely: trimmed {:.1f} mm (proximal) and {:.1f} mm (distal) instead of mesh.end_trim = {} mm",
+              w.end_trim_proximal, w.end_trim_distal, o.end_trim);
   summary.set("thinned_layer_ray_fraction", w.clamped_fraction);
   summary.set("min_section_gap_ratio", w.min_gap_ratio);
   summary.set("meshing_time", secs, "s");

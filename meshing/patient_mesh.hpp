@@ -29,7 +29,10 @@ struct PatientMeshOptions {
   double min_intima = 0.05;       // mm (DESIGN.md §8); thinner walls shrink media and adventitia to keep it
   double station_spacing = 0.5;   // mm between lofted cross-sections
   int points_per_section = 32;    // rays per cross-section
-  double end_trim = 0.2;          // mm cut off each centerline end
+  /// mm cut off each centerline end, at least; where the section there
+  /// leaves an obliquely cut open end, that end's trim grows up to one
+  /// reference diameter (WallSections::end_trim_proximal/distal).
+  double end_trim = 0.2;
   /// Consecutive sections must not meet inside the wall: each section's outer
   /// contour lies at least this fraction of the spacing beyond the
   /// neighbouring section's plane (1 on a straight tube, 1 - r/R on the inner
@@ -60,6 +63,7 @@ struct WallSections {
   std::vector<int> layers;  // layer between surface k and k+1 (tags::Layer)
   double clamped_fraction = 0;  // rays where media/adventitia shrank to keep min_intima
   double min_gap_ratio = 1;     // smallest gap between consecutive sections / spacing (check_wall_sections)
+  double end_trim_proximal = 0, end_trim_distal = 0;  // mm, the trims used
   Eigen::Vector3d point(std::size_t s, std::size_t k, std::size_t i) const;
 };
 

@@ -70,8 +70,36 @@ struct SectionLookup {
 
 namespace {
 
+MeshData loft_and_mesh(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh);
+
+/// gmsh 4.8 reports some failures (OCC lofts and booleans, tetgen's boundary
+/// recovery) by throwing a std::string or other non-std objects: each becomes
+/// a ComputeError with gmsh's last message, read while the session is open.
 MeshData mesh_with_gmsh(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh) {
   GmshSession session;
+  auto failed = [](const std::string& what) {
+    std::string last;
+    try {
+      gmsh::logger::getLastError(last);
+    } catch (...) {
+    }
+    return ComputeError(fmt::format("mesh: gmsh failed to loft or mesh the wall ({}{}{})", what,
+                                    last.empty() || last == what ? "" : ": ", last == what ? "" : last));
+  };
+  try {
+    return loft_and_mesh(w, o, msh);
+  } catch (const std::exception&) {
+    throw;
+  } catch (const std::string& e) {
+    throw failed(e);
+  } catch (const char* e) {
+    throw failed(e);
+  } catch (...) {
+    throw failed("no message");
+  }
+}
+
+MeshData loft_and_mesh(const WallSections& w, const PatientMeshOptions& o, const std::filesystem::path& msh) {
   namespace occ = gmsh::model::occ;
   gmsh::model::add("artery");
   const std::size_t ns = w.origin.size(), nk = w.radius[0].size(), nr = w.radius[0][0].size();
@@ -218,9 +246,7 @@ MeshData mesh_with_gmsh(const WallSections& w, const PatientMeshOptions& o, cons
     gmsh::model::mesh::generate(3);
     std::string last;
     gmsh::logger::getLastError(last);
-    if (!last.empty())
-      throw ComputeError(fmt::format("mesh: gmsh failed to mesh the layers ({}); try a smaller mesh.size or a larger "
-                                     "mesh.min_intima", last));
+    if (!last.empty()) throw ComputeError(fmt::format("mesh: gmsh failed to mesh the layers ({})", last));
   } catch (const ComputeError&) {
     throw;
   } catch (const std::exception& e) {
@@ -315,30 +341,7 @@ MeshData mesh_wall_sections(const WallSections& w, const PatientMeshOptions& o, 
   check_layer_sizing(w, o);
   log::info("mesh: lofting {} sections of {} surfaces and meshing them with gmsh ({}, size {} mm)", w.origin.size(),
             w.radius.empty() ? 0 : w.radius[0].size(), o.element, o.size);
-  // gmsh 4.8 reports some failures (OCC lofts and booleans, tetgen's boundary
-  // recovery) by throwing a std::string or other non-std objects: each
-  // becomes a ComputeError with gmsh's last message instead of a terminate.
-  auto failed = [](const std::string& what) {
-    std::string last;
-    try {
-      gmsh::logger::getLastError(last);
-    } catch (...) {
-    }
-    return ComputeError(fmt::format("mesh: gmsh failed ({}{}{}); try a smaller mesh.size, a larger mesh.min_intima or "
-                                    "a smaller region of interest",
-                                    what, last.empty() ? "" : ": ", last));
-  };
-  try {
-    return mesh_with_gmsh(w, o, msh);
-  } catch (const std::exception&) {
-    throw;
-  } catch (const std::string& e) {
-    throw failed(e);
-  } catch (const char* e) {
-    throw failed(e);
-  } catch (...) {
-    throw failed("no message");
-  }
+  return mesh_with_gmsh(w, o, msh);
 }
 
 }  // namespace stentsim::meshing
