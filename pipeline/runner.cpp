@@ -7,11 +7,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <map>
 #include <ostream>
+#include <set>
 
 #include "common/error.hpp"
 #include "common/files.hpp"
@@ -146,6 +148,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
   std::size_t counter = 0;
   const std::size_t total = selected.size();
   bool failing = false;
+  std::set<std::size_t> unusable;  // failed, or needing a failed stage (keep_going)
 
   auto ready = [&](std::size_t i) {
     for (std::size_t u : plan_.upstream(i))
@@ -218,7 +221,8 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       manifest.save(manifest_file());
       report.failed.push_back(s.name);
       if (report.first_failure.empty()) report.first_failure = fmt::format("{}: {}", s.name, o.message);
-      failing = true;
+      failing = !options.keep_going;
+      unusable.insert(r.stage);
       out << fmt::format("  FAIL  {:<13} {}\n", s.name, o.message);
       out << fmt::format("        log: {}\n", (plan_.work_dir() / "logs" / (s.name + ".log")).string());
       if (kept_partial) out << fmt::format("        partial outputs: {}\n", kept.string());
@@ -234,6 +238,17 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
     // Launch every ready stage while there is room and no stop or failure.
     for (auto it = pending.begin(); !failing && !g_stop_signal && it != pending.end() && static_cast<int>(running.size()) < jobs;) {
       const std::size_t i = *it;
+      const auto& up = plan_.upstream(i);
+      const auto bad = std::find_if(up.begin(), up.end(), [&](std::size_t u) { return unusable.count(u) > 0; });
+      if (bad != up.end()) {  // keep_going: what needs a failed stage cannot run
+        it = pending.erase(it);
+        unusable.insert(i);
+        ++counter;
+        report.blocked.push_back(stages[i].name);
+        out << fmt::format("[{}/{}] skip  {:<13} needs {}, which failed\n", counter, total, stages[i].name, stages[*bad].name);
+        it = pending.begin();
+        continue;
+      }
       if (!ready(i)) {
         ++it;
         continue;

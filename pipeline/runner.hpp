@@ -20,6 +20,9 @@ struct RunOptions {
   std::set<std::string> force;       // run these even if up to date
   bool dry_run = false;              // print the plan and why, run nothing
   int jobs = 1;                      // independent stages at once
+  /// After a failure, go on with every stage that does not need the failed
+  /// one (mesh and fibers need no placement); the exit code stays 1.
+  bool keep_going = false;
 };
 
 enum class StageState { up_to_date, stale, failed, never_run };
@@ -34,6 +37,7 @@ struct StageStatus {
 
 struct RunReport {
   std::vector<std::string> ran, skipped, failed;
+  std::vector<std::string> blocked;  // not run: they need a failed stage (keep_going)
   bool interrupted = false;
   std::string first_failure;  // "stage: message"
   /// 0 success, 1 a stage failed, 130 interrupted.

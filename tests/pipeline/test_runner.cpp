@@ -166,6 +166,30 @@ TEST_F(RunnerTest, FailingStageLeavesEarlierOutputsAndReportsIt) {
   EXPECT_EQ(count("c"), 2);
 }
 
+// --keep-going: after a fails, d (which does not need it) still runs, b and
+// c (which do) are reported as not run, and the exit code stays 1.
+TEST_F(RunnerTest, KeepGoingRunsWhatDoesNotNeedTheFailedStage) {
+  config["a"] = "fail";
+  RunOptions o;
+  o.keep_going = true;
+  auto rep = run(o);
+  EXPECT_EQ(rep.exit_code(), 1);
+  EXPECT_EQ(rep.failed, (std::vector<std::string>{"a"}));
+  EXPECT_EQ(rep.blocked, (std::vector<std::string>{"b", "c"}));
+  EXPECT_EQ(count("d"), 1);
+  EXPECT_EQ(count("b"), 0);
+  EXPECT_EQ(count("c"), 0);
+  EXPECT_TRUE(fs::exists(work / "d/out.txt"));
+  EXPECT_NE(last_output.find("skip  b             needs a, which failed"), std::string::npos) << last_output;
+  // Without it, nothing is launched after the failure (one job: the stages run in plan order).
+  fs::remove_all(work);
+  fs::remove_all(counters);
+  rep = run();
+  EXPECT_EQ(rep.exit_code(), 1);
+  EXPECT_TRUE(rep.blocked.empty());
+  EXPECT_EQ(count("b") + count("c"), 0);
+}
+
 TEST_F(RunnerTest, FailedStageKeepsItsPartialOutputsForTheUser) {
   run();
   const std::string before = files::read_text(work / "b/out.txt");

@@ -22,6 +22,7 @@ struct RunArgs {
   std::string force;  // --force [STAGE]: empty with the flag given = every stage
   bool dry_run = false;
   int jobs = 1;
+  bool keep_going = false;
 };
 
 pipeline::Runner make_runner(const workflows::CaseConfig& c) {
@@ -45,12 +46,15 @@ int run_case(RunArgs& a, bool force_given) {
   if (!a.force.empty()) o.force.insert(a.force);
   o.dry_run = a.dry_run;
   o.jobs = a.jobs;
+  o.keep_going = a.keep_going;
   std::cout << fmt::format("case {} ({} scene), work folder {}\n", c.name, workflows::to_string(c.scene), c.work_dir.string());
   const auto report = runner.run(o, std::cout);
   if (a.dry_run) return 0;
   const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::cout << fmt::format("{} ran, {} up to date, {} failed in {:.2f} s\n", report.ran.size(), report.skipped.size(),
-                           report.failed.size(), dt);
+  std::cout << fmt::format("{} ran, {} up to date, {} failed{} in {:.2f} s\n", report.ran.size(), report.skipped.size(),
+                           report.failed.size(),
+                           report.blocked.empty() ? "" : fmt::format(", {} not run (they need a failed stage)", report.blocked.size()),
+                           dt);
   if (report.interrupted) std::cerr << "interrupted: finished stages are kept; run again to resume\n";
   if (!report.first_failure.empty()) std::cerr << "error: stage " << report.first_failure << "\n";
   return report.exit_code();
@@ -84,6 +88,8 @@ void register_run(CLI::App& app) {
   run->get_option("--only")->check(CLI::Validator([](std::string& v) { return v.empty() ? "a stage name is required" : ""; }, "STAGE"));
   run->add_flag("--dry-run", args->dry_run, "Print the plan and why each stage would run; run nothing");
   run->add_option("--jobs,-j", args->jobs, "Independent stages to run at once")->check(CLI::Range(1, 64));
+  run->add_flag("--keep-going,-k", args->keep_going,
+                "After a failure, run every stage that does not need the failed one (the exit code stays 1)");
   on(run, [args, force] { return run_case(*args, force->count() > 0); });
 
   auto file = std::make_shared<std::string>();
