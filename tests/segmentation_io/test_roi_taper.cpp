@@ -11,6 +11,7 @@
 #include "common/error.hpp"
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/tree_input.hpp"
+#include "tests/segmentation_io/radial_tube.hpp"
 
 using namespace stentsim;
 using namespace stentsim::segmentation;
@@ -28,21 +29,7 @@ double lumen_radius(double s) {
 }
 
 TriSurface tapered_tube(int rings, int around) {
-  TriSurface t;
-  for (int k = 0; k <= rings; ++k) {
-    const double z = kLength * k / rings, r = lumen_radius(z);
-    for (int j = 0; j < around; ++j) {
-      const double a = 2 * M_PI * j / around;
-      t.points.emplace_back(r * std::cos(a), r * std::sin(a), z);
-    }
-  }
-  for (int k = 0; k < rings; ++k)
-    for (int j = 0; j < around; ++j) {
-      const int a = k * around + j, b = k * around + (j + 1) % around, c = a + around, d = b + around;
-      t.triangles.push_back({a, b, d});
-      t.triangles.push_back({a, d, c});
-    }
-  return t;
+  return stentsim::testing::radial_tube(kLength, [](double z, double) { return lumen_radius(z); }, rings, around);
 }
 
 CenterlineResult straight_centerline(int n) {

@@ -17,6 +17,7 @@
 #include "segmentation_io/segmentation_stage.hpp"
 #include "segmentation_io/surface_distance.hpp"
 #include "segmentation_io/triangle_surface.hpp"
+#include "tests/segmentation_io/radial_tube.hpp"
 
 using namespace stentsim;
 using namespace stentsim::segmentation;
@@ -26,24 +27,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-/// An open tube along z, 0 to `length`, with radius r(z, θ) about the z axis.
-TriSurface radial_tube(double length, const std::function<double(double, double)>& r, int rings = 200, int around = 96) {
-  TriSurface t;
-  for (int k = 0; k <= rings; ++k) {
-    const double z = length * k / rings;
-    for (int j = 0; j < around; ++j) {
-      const double a = 2 * kPi * j / around, rr = r(z, a);
-      t.points.emplace_back(rr * std::cos(a), rr * std::sin(a), z);
-    }
-  }
-  for (int k = 0; k < rings; ++k)
-    for (int j = 0; j < around; ++j) {
-      const int a = k * around + j, b = k * around + (j + 1) % around, c = a + around, d = b + around;
-      t.triangles.push_back({a, b, d});
-      t.triangles.push_back({a, d, c});
-    }
-  return t;
-}
+using stentsim::testing::radial_tube;
 
 /// Distance from the lumen vertex at (z, θ) to the wall, and the wall's
 /// radius along the same ray (nearest wall vertex direction), for vertices

@@ -84,7 +84,7 @@ TEST_F(Cli, StenosisSectionReachesCenterlineAndPlacement) {
   stentsim::files::write_atomic(c, base);
   auto r = sh("run " + c.string() + " --until placement");
   ASSERT_EQ(r.code, 0) << r.out;
-  const auto summary = stentsim::Summary::read(dir / "st.work" / "centerline" / "summary.yaml");
+  const auto summary = stentsim::Summary::read(dir / "case.work" / "centerline" / "summary.yaml");
   ASSERT_EQ(std::get<double>(summary.qois().at("lesion_count").value), 1.0) << r.out;
   EXPECT_NEAR(std::get<double>(summary.qois().at("lesion_1_percent_diameter").value), 20.0, 2.0);
   stentsim::files::write_atomic(c, base + "stenosis: {threshold_percent: 30}\n");
