@@ -4,6 +4,8 @@
 // flying edges with volume-preserving windowed-sinc smoothing, in the image's
 // physical coordinates, opened at the vessel's two ends by planar cuts.
 #include <filesystem>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "segmentation_io/triangle_surface.hpp"
@@ -30,5 +32,9 @@ struct LabelSurfaceOptions {
 /// the `axis_labels` voxels). InputError naming the
 /// file for an unknown extension, an unreadable file or no voxel with a label.
 TriSurface label_image_surface(const std::filesystem::path& file, const LabelSurfaceOptions& options);
+
+/// The spatial unit a NIfTI file's header states (xyzt_units & 7: "m", "mm",
+/// "um"); nullopt for other formats or an unknown unit (0).
+std::optional<std::string> nifti_spatial_units(const std::filesystem::path& file);
 
 }  // namespace stentsim::segmentation

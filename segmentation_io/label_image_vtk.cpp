@@ -7,6 +7,7 @@
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
 #include <vtkMetaImageReader.h>
+#include <vtkNIFTIImageHeader.h>
 #include <vtkNIFTIImageReader.h>
 #include <vtkNrrdReader.h>
 #include <vtkPointData.h>
@@ -210,6 +211,22 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   }
   auto pieces = connected_pieces(s);
   return pieces.front();
+}
+
+std::optional<std::string> nifti_spatial_units(const std::filesystem::path& file) {
+  std::string lower = file.string();
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (!(ends_with(lower, ".nii") || ends_with(lower, ".nii.gz")) || !std::filesystem::exists(file)) return std::nullopt;
+  auto r = vtkSmartPointer<vtkNIFTIImageReader>::New();
+  if (!r->CanReadFile(file.string().c_str())) return std::nullopt;
+  r->SetFileName(file.string().c_str());
+  r->UpdateInformation();
+  switch (r->GetNIFTIHeader()->GetXYZTUnits() & 0x07) {
+    case vtkNIFTIImageHeader::UnitsMeter: return "m";
+    case vtkNIFTIImageHeader::UnitsMM: return "mm";
+    case vtkNIFTIImageHeader::UnitsMicron: return "um";
+    default: return std::nullopt;
+  }
 }
 
 }  // namespace stentsim::segmentation

@@ -84,6 +84,7 @@ LabelImageInput parse_label_image_input(ConfigMap& section) {
   if (section.has("wall_label")) in.wall_label = section.integer("wall_label");
   in.smoothing_iterations = section.integer("smoothing_iterations", 20, Range::between(0, 500));
   in.end_trim = section.quantity("end_trim", units::kLength, 0.0, Range::non_negative());
+  in.units_given = section.has("units");
   in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
   in.checks.repair = section.boolean("repair", true);
   in.synthesis = parse_wall_synthesis(section);
@@ -235,9 +236,24 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     synthesis = sv->synthesis;
     kind = "simvascular";
   } else if (const auto* li = std::get_if<LabelImageInput>(&input.source)) {
+    // Units: the case's, else the NIfTI header's (xyzt_units), else mm; a
+    // case that contradicts the header is an error.
+    checks = li->checks;
+    if (const auto header = nifti_spatial_units(li->file)) {
+      if (!li->units_given) {
+        checks.units = *header;
+      } else if (*header != li->checks.units) {
+        throw InputError(fmt::format("{}: the NIfTI header gives the voxel spacing in {} (xyzt_units), but "
+                                     "input.label_image.units is {}; remove units or set it to {}",
+                                     li->file.string(), unit_word(*header), li->checks.units, *header));
+      }
+      summary.note("label_image_units", fmt::format("{} ({})", checks.units,
+                                                    li->units_given ? "input.label_image.units, as the NIfTI header"
+                                                                    : "the NIfTI header's xyzt_units"));
+    }
     LabelSurfaceOptions lo;
     lo.smoothing_iterations = li->smoothing_iterations;
-    lo.end_trim = li->end_trim / unit_length_in_mm(li->checks.units);  // mm → the image's units
+    lo.end_trim = li->end_trim / unit_length_in_mm(checks.units);  // mm → the image's units
     lo.labels = {li->lumen_label};
     // Lumen and wall are cut by the same planes, placed by the outer region.
     if (li->wall_label) lo.axis_labels = {li->lumen_label, *li->wall_label};
@@ -249,7 +265,6 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
       wall_name = li->file.string() + fmt::format(" (labels {} and {})", li->lumen_label, *li->wall_label);
       have_wall = true;
     }
-    checks = li->checks;
     synthesis = li->synthesis;
     kind = "label_image";
   } else if (const auto* tr = std::get_if<TreeInput>(&input.source)) {

@@ -82,6 +82,7 @@ struct LabelImageInput {
   std::optional<int> wall_label;         // the wall region's label; the outer wall encloses lumen ∪ wall
   int smoothing_iterations = 20;
   double end_trim = 0;                   // mm; 0: automatic (see LabelSurfaceOptions)
+  bool units_given = false;              // `units:` set in the case; else a NIfTI header's xyzt_units decides
   SurfaceCheckOptions checks;
   WallSynthesisOptions synthesis;
 };

@@ -5,6 +5,7 @@
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
 #include <vtkMetaImageWriter.h>
+#include <vtkNIFTIImageHeader.h>
 #include <vtkNIFTIImageWriter.h>
 #include <vtkSmartPointer.h>
 
@@ -162,6 +163,51 @@ TEST(LabelImage, NiftiQformRotatesAndTranslates) {
   EXPECT_NEAR(t.mean_r, kR, 0.02 * kR);
   EXPECT_LT(t.max_dev, 0.08);
   EXPECT_NEAR(t.volume, exact, 0.03 * exact);
+  fs::remove_all(dir);
+}
+
+// NIfTI's xyzt_units is the file's unit when the case gives none (the units
+// rule): the same cylinder with its spacing in metres and the header saying
+// metres gives the millimetre lumen; a case that says mm is an error naming
+// both and the setting, and removing it (or saying m) clears it.
+TEST(LabelImage, NiftiXyztUnitsGiveTheUnitsAndAContradictionIsAnError) {
+  const fs::path dir = fs::temp_directory_path() / "stentsim_label_nii_units";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const double zero[3] = {0, 0, 0};
+  auto im = cylinder(zero);
+  im->SetSpacing(kSp[0] / 1000, kSp[1] / 1000, kSp[2] / 1000);
+  auto hdr = vtkSmartPointer<vtkNIFTIImageHeader>::New();
+  hdr->SetXYZTUnits(vtkNIFTIImageHeader::UnitsMeter);
+  auto w = vtkSmartPointer<vtkNIFTIImageWriter>::New();
+  w->SetInputData(im);
+  w->SetNIFTIHeader(hdr);
+  w->SetFileName((dir / "labels_m.nii").c_str());
+  w->Write();
+  ASSERT_EQ(nifti_spatial_units(dir / "labels_m.nii").value_or("none"), "m");
+  auto run = [&](const std::string& units_line) {
+    auto cfg = ConfigMap::from_string("label_image:\n  file: " + (dir / "labels_m.nii").string() +
+                                          "\n  lumen_label: 1\n" + units_line,
+                                      dir / "case.yaml");
+    SegmentationInput in = parse_segmentation_input(cfg);
+    Summary summary;
+    run_segmentation_stage(in, dir / "lumen.vtp", dir / "wall.vtp", summary);
+    return summary;
+  };
+  const Summary ok = run("");
+  const double d = std::get<double>(ok.qois().at("lumen_reference_diameter").value);
+  std::printf("NIfTI in metres (xyzt_units): reference diameter %.4f mm (true %.2f)\n", d, 2 * kR);
+  EXPECT_NEAR(d, 2 * kR, 0.1 * kR);
+  std::string msg;
+  try {
+    run("  units: mm\n");
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("labels_m.nii"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("metres (xyzt_units)"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("set it to m"), std::string::npos) << msg;
+  EXPECT_NO_THROW(run("  units: m\n"));
   fs::remove_all(dir);
 }
 
