@@ -1,5 +1,5 @@
 #pragma once
-// The one stenosis rule of the pipeline (issue: real vessels): the centerline
+// The one stenosis rule of the pipeline: the centerline
 // stage, the device placement, the segmentation's region of interest and the
 // wall synthesis all find lesions with analyse_stenoses, so they name the same
 // sites, reference radii and percent stenoses.

@@ -80,8 +80,10 @@ Placement compute_placement(const PlacementParams& prm, const Centerline& cl, co
     std::istringstream in(lumen->field_text.at(tags::kTreatedSite));
     in >> x.x() >> x.y() >> x.z();
     double at = cl.begin(), best = std::numeric_limits<double>::infinity();
-    for (double sv : cl.abscissa)
-      if ((cl.point_at(sv) - x).norm() < best) best = (cl.point_at(sv) - x).norm(), at = sv;
+    for (double sv : cl.abscissa) {
+      const double d = (cl.point_at(sv) - x).norm();
+      if (d < best) best = d, at = sv;
+    }
     const Lesion* lesion = prof->nearest(at);
     P.site_abscissa = lesion && at >= lesion->start && at <= lesion->end ? lesion->abscissa : at;
     P.site_chosen_by = "the region of interest's lesion";

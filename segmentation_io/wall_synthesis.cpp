@@ -148,12 +148,18 @@ TriSurface synthesize_wall(const TriSurface& lumen, const WallSynthesisOptions& 
     }
     return out;
   };
+  // The half-way contours, each shared by the two stations either side.
+  std::vector<std::vector<double>> halfway(ns > 0 ? ns - 1 : 0);
+  for (std::size_t k = 0; k + 1 < ns; ++k) halfway[k] = contour((st[k] + st[k + 1]) / 2);
   for (std::size_t k = 0; k < ns; ++k) {
     const std::size_t i = st[k];
     rho[k] = contour(i);
-    for (std::size_t m : {k > 0 ? (st[k - 1] + i) / 2 : i, k + 1 < ns ? (i + st[k + 1]) / 2 : i}) {
+    for (std::size_t side = 0; side < 2; ++side) {
+      if ((side == 0 && k == 0) || (side == 1 && k + 1 == ns)) continue;
+      const std::size_t between = side == 0 ? k - 1 : k;
+      const std::size_t m = (st[between] + st[between + 1]) / 2;
       if (m == i) continue;
-      const std::vector<double> half = contour(m);
+      const std::vector<double>& half = halfway[between];
       for (int j = 0; j < N; ++j) {
         const double v = half[std::size_t(j)];
         if (std::isnan(v) || std::isnan(rho[k][std::size_t(j)])) continue;

@@ -2,7 +2,7 @@
 // the healthy reference contour dilated by the layer rule's thickness
 // t = (t_I + 0.2146 D_ref) / 0.5708. Lumens with an oval section, a
 // side-branch stub and a flared end: the shapes where a wall of circles
-// about the centerline (the previous synthesis) was too thin on one side,
+// about the centerline would be too thin on one side,
 // reached far beyond the lumen on all sides, or dipped inside it.
 #include <gtest/gtest.h>
 
