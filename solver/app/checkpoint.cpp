@@ -12,6 +12,9 @@ void SolverCheckpoint::put(HistoryArchive& out) const {
   out.put("solver/linear_iterations", static_cast<double>(counters.linear_iterations));
   out.put("solver/step_cuts", static_cast<double>(counters.step_cuts));
   out.put("solver/steps", static_cast<double>(counters.steps));
+  out.put("solver/predicted_steps", static_cast<double>(counters.predicted_steps));
+  out.put("solver/last_increment", std::span<const double>(last_increment.data(), static_cast<std::size_t>(last_increment.size())));
+  out.put("solver/last_dt", last_dt);
 }
 
 SolverCheckpoint SolverCheckpoint::get(const HistoryArchive& in, long long dofs) {
@@ -24,6 +27,13 @@ SolverCheckpoint SolverCheckpoint::get(const HistoryArchive& in, long long dofs)
   c.counters.linear_iterations = static_cast<long>(in.get_scalar("solver/linear_iterations"));
   c.counters.step_cuts = static_cast<long>(in.get_scalar("solver/step_cuts"));
   c.counters.steps = static_cast<int>(in.get_scalar("solver/steps"));
+  c.counters.predicted_steps = static_cast<int>(in.get_scalar("solver/predicted_steps"));
+  const auto& inc = in.get("solver/last_increment");
+  if (!inc.empty()) {
+    const auto& sized = in.get("solver/last_increment", dofs);
+    c.last_increment = Eigen::Map<const Eigen::VectorXd>(sized.data(), static_cast<Eigen::Index>(sized.size()));
+  }
+  c.last_dt = in.get_scalar("solver/last_dt");
   return c;
 }
 

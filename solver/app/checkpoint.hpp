@@ -1,7 +1,7 @@
 #pragma once
 // The solver's own part of checkpoint.bin (HistoryArchive keys "solver/…"):
-// the state vector, the time reached, the step size to try next and the run's
-// counters. Terms (Model::save_history), the results writer and the run
+// the state vector, the time reached, the step size to try next, the last
+// step's increment and size (the predictor's start) and the run's counters. Terms (Model::save_history), the results writer and the run
 // observers add their parts under their own prefixes.
 #include <Eigen/Core>
 
@@ -12,11 +12,14 @@ namespace stentsim::solver {
 struct RunCounters {
   long newton_iterations = 0, linear_iterations = 0, step_cuts = 0;
   int steps = 0;
+  int predicted_steps = 0;  // steps whose converged attempt started from the predictor's guess
 };
 
 struct SolverCheckpoint {
   Eigen::VectorXd u;
   double time = 0.0, next_dt = 0.0;
+  Eigen::VectorXd last_increment;  // empty: no predictor for the first step after the restart
+  double last_dt = 0.0;
   RunCounters counters;
 
   void put(HistoryArchive& out) const;

@@ -81,6 +81,8 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     stepping.t_start = t_last;
     stepping.dt_initial = state.next_dt;
     stepping.first_step = counters.steps;
+    stepping.last_increment = state.last_increment;
+    stepping.last_dt = state.last_dt;
     log::info("restart from {}: step {}, t = {:.6g}, next dt = {:.3g}", from.string(), counters.steps, t_last, stepping.dt_initial);
   } else {
     frame(stepping.t_start);
@@ -100,6 +102,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     counters.newton_iterations += r.newton_iterations;
     counters.linear_iterations += r.linear_iterations;
     counters.step_cuts += r.cuts;
+    counters.predicted_steps += r.predicted ? 1 : 0;
     for (const auto& [prefix, o] : observers) o->step(r, u);
     std::vector<double> row{static_cast<double>(r.step), r.time, r.dt, lf ? (*lf)(r.time) : r.time,
                             static_cast<double>(r.newton_iterations), static_cast<double>(r.linear_iterations),
@@ -113,7 +116,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     if (r.step % scene.output_every == 0 || at_stop) frame(r.time);
     if (scene.checkpoint_every > 0 && r.step % scene.checkpoint_every == 0 && writes) {
       HistoryArchive ck;
-      SolverCheckpoint{u, r.time, r.next_dt, counters}.put(ck);
+      SolverCheckpoint{u, r.time, r.next_dt, r.increment, r.dt, counters}.put(ck);
       for (const auto& [prefix, o] : observers) o->save(ck, prefix);
       model.save_history(ck);
       writer.save(ck);
@@ -154,6 +157,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   summary.set("newton_iterations", static_cast<double>(counters.newton_iterations));
   summary.set("linear_iterations", static_cast<double>(counters.linear_iterations));
   summary.set("step_cuts", static_cast<double>(counters.step_cuts));
+  summary.set("predicted_steps", static_cast<double>(counters.predicted_steps));
   summary.set("dofs", static_cast<double>(model.dofs.size()));
   summary.set("final_time", t_last, "s");
   summary.note("scene", file);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <map>
 
@@ -29,9 +30,8 @@ BeamToSurfacePair::BeamToSurfacePair(std::string name, const beams::BeamTerm& be
     gauss_.push_back(std::move(g));
   }
   const std::size_t points = body.elements.size() * static_cast<std::size_t>(settings_.gauss_points);
-  active_committed_.assign(points, 0);
-  active_trial_.assign(points, 0);
-  flips_.assign(points, 0);
+  active_.resize(points);
+  reserved_.assign(body.elements.size(), {});
 }
 
 std::array<Vec3, 4> BeamToSurfacePair::centerline(const Eigen::VectorXd& u, std::size_t e) const {
@@ -111,7 +111,7 @@ void BeamToSurfacePair::refresh_search(const Eigen::VectorXd& u) {
 void BeamToSurfacePair::begin_step(const SystemState& state) {
   surface_->update(state.u);
   refresh_search(state.u);
-  std::fill(flips_.begin(), flips_.end(), 0);
+  active_.begin_step();
 }
 
 NormalProjection BeamToSurfacePair::project(const ContactSurface& surface, const std::vector<int>& faces, const Vec3& p,
@@ -182,7 +182,7 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
           project(*surface_, candidates_[e].faces, p, face, where, tangent ? &unconverged : nullptr, &face_boxes_);
       // A point in contact in the last converged state that now projects nowhere, or far through the
       // surface, would silently lose its force: a failed iteration instead (the step is cut).
-      if (active_committed_[id] && (where == Reach::nowhere || where == Reach::deep))
+      if (active_.committed(id) && (where == Reach::nowhere || where == Reach::deep))
         throw ElementFailure(fmt::format("contact '{}': Gauss point {} of beam element {} at ({:.4g}, {:.4g}, {:.4g}) was in "
                                          "contact in the last converged state but {} now",
                                          name_, q, e, p.x(), p.y(), p.z(),
@@ -191,10 +191,11 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       const bool active = face >= 0 && pr.distance - settings_.radius < settings_.law.active_limit();
       // The active set of Newton iterates (tangent assemblies), not of line-search trials.
       if (tangent) {
-        if (static_cast<bool>(active_trial_[id]) != active && ++flips_[id] > settings_.max_flips)
+        const int changes = active_.evaluate(id, active);
+        if (changes > settings_.max_flips)
           throw ElementFailure(fmt::format("contact '{}': Gauss point {} of beam element {} switched in and out of contact {} "
-                                           "times in this step (active-set chattering)", name_, q, e, flips_[id]));
-        active_trial_[id] = active;
+                                           "times in this step (active-set chattering; max_flips = {})", name_, q, e, changes,
+                                           settings_.max_flips));
       }
       if (!active) continue;
       double phi, d1, d2;
@@ -309,13 +310,21 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       out.add(dofs, r, K);
     }
     if (tangent && !pattern_reserved_) {
+      // The global pattern only grows: a pair reserved after an earlier search still has its entries.
+      std::vector<int>& done = reserved_[e];
       for (int face : candidates_[e].faces) {
+        if (std::binary_search(done.begin(), done.end(), face)) continue;
         if (std::any_of(blocks.begin(), blocks.end(), [&](const PairBlock& b) { return b.face == face; })) continue;
         patch_of(face, patch);
         const std::vector<GlobalDof> dofs = dofs_of(patch);
         const auto n = static_cast<Eigen::Index>(dofs.size());
         out.add(dofs, Eigen::VectorXd::Zero(n), Eigen::MatrixXd::Zero(n, n));
       }
+      std::vector<int> merged;
+      std::vector<int> now = candidates_[e].faces;
+      std::sort(now.begin(), now.end());
+      std::set_union(done.begin(), done.end(), now.begin(), now.end(), std::back_inserter(merged));
+      done.swap(merged);
     }
   }
   if (tangent) pattern_reserved_ = true, unconverged_ = unconverged;
@@ -360,22 +369,18 @@ std::vector<BeamContactPoint> BeamToSurfacePair::evaluate(const Eigen::VectorXd&
 }
 
 void BeamToSurfacePair::commit() {
-  gather_owned_flags(active_trial_, static_cast<std::size_t>(settings_.gauss_points), rank_, ranks_);
-  active_committed_ = active_trial_;
+  active_.commit(static_cast<std::size_t>(settings_.gauss_points), rank_, ranks_);
   if (unconverged_ > 0)
     log::warn("contact '{}': {} projections onto candidate faces did not converge in the converged state (those points count as "
               "out of contact there)", name_, unconverged_);
 }
 
 void BeamToSurfacePair::save_history(HistoryArchive& out, const std::string& prefix) const {
-  std::vector<double> a(active_committed_.begin(), active_committed_.end());
-  out.put(prefix + "active", a);
+  active_.save(out, prefix + "active");
 }
 
 void BeamToSurfacePair::load_history(const HistoryArchive& in, const std::string& prefix) {
-  const auto& a = in.get(prefix + "active", static_cast<long long>(active_committed_.size()));
-  for (std::size_t i = 0; i < a.size(); ++i) active_committed_[i] = a[i] != 0.0;
-  active_trial_ = active_committed_;
+  active_.load(in, prefix + "active");
 }
 
 }  // namespace stentsim::solver::contact

@@ -25,7 +25,8 @@
 // out of contact — unless it was in contact in the last converged state: then
 // the trial state is a failed iteration (ElementFailure) and the step is cut,
 // never a silent loss of a contact point. Active-set chattering (a point that
-// flips in and out more than `max_flips` times within one step) also fails the
+// flips in and out more than `max_flips` times between the accepted Newton
+// iterates of one step, active_set.hpp) also fails the
 // iteration. MPI: every rank searches all elements and assembles the beam
 // elements of its fixed partition (SystemState::owns).
 #include <memory>
@@ -33,6 +34,7 @@
 #include <vector>
 
 #include "solver/beams/beam_term.hpp"
+#include "solver/contact/active_set.hpp"
 #include "solver/contact/contact_surface.hpp"
 #include "solver/contact/face_search.hpp"
 #include "solver/contact/normal_projection.hpp"
@@ -84,7 +86,8 @@ class BeamToSurfacePair : public Term {
   /// Every rank evaluated its own elements only: the flags are gathered so that every rank
   /// (and rank 0's checkpoint) holds all of them.
   void commit() override;
-  void rollback() override { active_trial_ = active_committed_; }
+  void accept() override { active_.accept(); }
+  void rollback() override { active_.rollback(); }
   /// The active flags of the last converged state (the projection-failure rule needs them).
   bool has_history() const override { return true; }
   void save_history(HistoryArchive& out, const std::string& prefix) const override;
@@ -132,8 +135,8 @@ class BeamToSurfacePair : public Term {
   std::vector<Eigen::AlignedBox3d> face_boxes_;
   std::vector<Vec3> searched_points_, searched_nodes_;
   bool pattern_reserved_ = false;
-  std::vector<char> active_committed_, active_trial_;  // per Gauss point (element-major)
-  std::vector<int> flips_;
+  std::vector<std::vector<int>> reserved_;  // per element, the faces whose pattern was reserved (sorted)
+  ActiveSet active_;  // per Gauss point (element-major)
   long long searches_ = 0;
   int unconverged_ = 0;  // projections that did not converge in the last tangent assembly
   int rank_ = 0, ranks_ = 1;  // partition of the last assembly

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <map>
 
@@ -78,9 +79,8 @@ SurfaceToSurfacePair::SurfaceToSurfacePair(std::string name, std::unique_ptr<Con
     }
     gauss_.push_back(std::move(g));
   }
-  active_committed_.assign(slave_->num_nodes(), 0);
-  active_trial_ = active_committed_;
-  flips_.assign(slave_->num_nodes(), 0);
+  active_.resize(slave_->num_nodes());
+  reserved_.assign(slave_->faces().size(), {});
 }
 
 void SurfaceToSurfacePair::search(const ContactSurface& slave, const ContactSurface& master, Candidates& out) const {
@@ -121,7 +121,7 @@ void SurfaceToSurfacePair::begin_step(const SystemState& state) {
   slave_->update(state.u);
   master_->update(state.u);
   refresh_search();
-  std::fill(flips_.begin(), flips_.end(), 0);
+  active_.begin_step();
 }
 
 void SurfaceToSurfacePair::point_gaps(const ContactSurface& slave, const ContactSurface& master, const Candidates& cand, int face,
@@ -355,20 +355,43 @@ void SurfaceToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       done[static_cast<std::size_t>(fi)] = 1;
     }
   }
+  // The global pattern only grows: a slave node needs its pattern reserved again only when one
+  // of its faces has a master candidate that no earlier search gave it.
+  std::vector<char> fresh;
+  if (tangent && !pattern_reserved_) {
+    fresh.assign(slave_->faces().size(), 0);
+    for (std::size_t f = 0; f < fresh.size(); ++f) {
+      const std::vector<int>& done = reserved_[f];
+      for (int mf : candidates_[f])
+        if (!std::binary_search(done.begin(), done.end(), mf)) fresh[f] = 1;
+    }
+  }
   for (std::size_t j = 0; j < ns; ++j) {
     if (!state.owns(j, ns)) continue;
     const NodeResult r = assemble_node(*slave_, *master_, static_cast<int>(j), gaps, tangent, &out);
-    if (tangent && static_cast<bool>(active_trial_[j]) != r.active && ++flips_[j] > settings_.max_flips)
-      throw ElementFailure(fmt::format("contact '{}': slave node {} of body '{}' switched in and out of contact {} times in this "
-                                       "step (active-set chattering)", name_, slave_->body_node(static_cast<int>(j)),
-                                       slave_->body().name(), flips_[j]));
-    if (tangent) active_trial_[j] = r.active;  // the active set of Newton iterates, not of line-search trials
+    if (tangent) {
+      const int changes = active_.evaluate(j, r.active);
+      if (changes > settings_.max_flips)
+        throw ElementFailure(fmt::format("contact '{}': slave node {} of body '{}' switched in and out of contact {} times in this "
+                                         "step (active-set chattering; max_flips = {})", name_, slave_->body_node(static_cast<int>(j)),
+                                         slave_->body().name(), changes, settings_.max_flips));
+    }
     if (tangent && !pattern_reserved_) {
+      const auto& faces = slave_->node_faces(static_cast<int>(j));
+      if (std::none_of(faces.begin(), faces.end(), [&](int fi) { return fresh[static_cast<std::size_t>(fi)] != 0; })) continue;
       const std::vector<GlobalDof> dofs = candidate_dofs(static_cast<int>(j));
       const auto n = static_cast<Eigen::Index>(dofs.size());
       if (n > 0) out.add(dofs, Eigen::VectorXd::Zero(n), Eigen::MatrixXd::Zero(n, n));
     }
   }
+  if (tangent && !pattern_reserved_)
+    for (std::size_t f = 0; f < fresh.size(); ++f) {
+      if (!fresh[f]) continue;
+      std::vector<int> now = candidates_[f], merged;
+      std::sort(now.begin(), now.end());
+      std::set_union(reserved_[f].begin(), reserved_[f].end(), now.begin(), now.end(), std::back_inserter(merged));
+      reserved_[f].swap(merged);
+    }
   if (tangent) pattern_reserved_ = true;
 }
 
@@ -439,19 +462,15 @@ SurfaceContactState SurfaceToSurfacePair::evaluate(const Eigen::VectorXd& u) con
 }
 
 void SurfaceToSurfacePair::commit() {
-  gather_owned_flags(active_trial_, 1, rank_, ranks_);  // one flag per slave node
-  active_committed_ = active_trial_;
+  active_.commit(1, rank_, ranks_);  // one flag per slave node
 }
 
 void SurfaceToSurfacePair::save_history(HistoryArchive& out, const std::string& prefix) const {
-  std::vector<double> a(active_committed_.begin(), active_committed_.end());
-  out.put(prefix + "active", a);
+  active_.save(out, prefix + "active");
 }
 
 void SurfaceToSurfacePair::load_history(const HistoryArchive& in, const std::string& prefix) {
-  const auto& a = in.get(prefix + "active", static_cast<long long>(active_committed_.size()));
-  for (std::size_t i = 0; i < a.size(); ++i) active_committed_[i] = a[i] != 0.0;
-  active_trial_ = active_committed_;
+  active_.load(in, prefix + "active");
 }
 
 }  // namespace stentsim::solver::contact

@@ -35,7 +35,8 @@
 // pairs reserve their matrix pattern once after each search; the search is
 // redone when a slave or master node moved more than half the margin since.
 // Active-set chattering (a node that flips more than `max_flips` times in one
-// step) fails the iteration (ElementFailure) so the step is cut.
+// step, counted between accepted Newton iterates: active_set.hpp) fails the
+// iteration (ElementFailure) so the step is cut.
 // MPI: every rank searches everything and assembles the slave nodes of its
 // fixed partition (SystemState::owns over slave nodes), computing the
 // Gauss points of the faces around them.
@@ -43,6 +44,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/contact/active_set.hpp"
 #include "solver/contact/contact_surface.hpp"
 #include "solver/contact/direction_projection.hpp"
 #include "solver/contact/penalty_law.hpp"
@@ -98,7 +100,8 @@ class SurfaceToSurfacePair : public Term {
   void begin_step(const SystemState& state) override;
   void assemble(const SystemState& state, Assembler& out) override;
   void commit() override;
-  void rollback() override { active_trial_ = active_committed_; }
+  void accept() override { active_.accept(); }
+  void rollback() override { active_.rollback(); }
   /// The nodal active flags of the last converged state (the chattering count starts from them).
   bool has_history() const override { return true; }
   void save_history(HistoryArchive& out, const std::string& prefix) const override;
@@ -155,8 +158,8 @@ class SurfaceToSurfacePair : public Term {
   Candidates candidates_;
   std::vector<Vec3> searched_slave_, searched_master_;
   bool pattern_reserved_ = false;
-  std::vector<char> active_committed_, active_trial_;
-  std::vector<int> flips_;
+  Candidates reserved_;  // per slave face, the master faces whose pattern was reserved (sorted)
+  ActiveSet active_;  // per slave node
   long long searches_ = 0;
 };
 

@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/log.hpp"
 #include "solver/linalg/linear_solver.hpp"
 
 namespace stentsim::solver {
@@ -64,6 +65,9 @@ class UmfpackSolver : public LinearSolver {
       }
       row_ptr_ = a.row_ptr;
       cols_ = a.cols;
+      log::debug("UMFPACK analysis: n = {}, nnz(A) = {}, estimated nnz(L + U) = {:.0f}, {:.0f} MB", n, a.nonzeros(),
+                 info_[UMFPACK_LNZ_ESTIMATE] + info_[UMFPACK_UNZ_ESTIMATE],
+                 info_[UMFPACK_NUMERIC_SIZE_ESTIMATE] * info_[UMFPACK_SIZE_OF_UNIT] / 1e6);
     }
     if (numeric_) umfpack_dl_free_numeric(&numeric_);
     const SuiteSparse_long st = umfpack_dl_numeric(ap, ai, a.values.data(), symbolic_, &numeric_, control_, info_);

@@ -21,6 +21,8 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
   double t = s.t_start, dt = std::min(s.dt_initial, s.dt_max);
   int step = s.first_step;
   int cuts_since_easy = 0;  // the stall counter: cuts since the last easy step
+  Eigen::VectorXd last_increment = s.last_increment;
+  double last_h = s.last_dt;
   const auto run_start = std::chrono::steady_clock::now();
   while (t < s.t_end - eps) {
     const double next_stop = *std::upper_bound(stops.begin(), stops.end(), t + eps);
@@ -31,9 +33,11 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
       double h = std::min(dt, next_stop - t);
       if (next_stop - (t + h) < 0.01 * h) h = next_stop - t;  // no sliver steps before a stop
       NewtonResult nr;
+      Eigen::VectorXd guess;
+      if (newton.predictor && last_h > 0.0 && last_increment.size() == u.size()) guess = (h / last_h) * last_increment;
       try {
         model.begin_step(u, t + h, h);
-        nr = newton_step(model, system, linear, u, t + h, h, newton);
+        nr = newton_step(model, system, linear, u, t + h, h, newton, &guess);
       } catch (const ElementFailure& e) {
         nr.failure = e.what();  // a term could not prepare the step (e.g. a contact search): cut it
       }
@@ -47,6 +51,12 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
         t += h;
         rec.dt = h;
         rec.residual_norms = nr.residual_norms;
+        rec.predicted = nr.predicted;
+        if (guess.size() == nr.increment.size())
+          log::debug("  predictor: |increment| = {:.3e}, |guess| = {:.3e}, |increment - guess| = {:.3e}", nr.increment.norm(),
+                     guess.norm(), (nr.increment - guess).norm());
+        last_increment = nr.increment;
+        last_h = h;
         if (nr.iterations <= s.easy_iterations && cuts == 0) {
           dt = std::min(dt * s.grow_factor, s.dt_max);
           cuts_since_easy = 0;
@@ -80,6 +90,7 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
     rec.time = t;
     rec.cuts = cuts;
     rec.next_dt = dt;
+    rec.increment = last_increment;
     rec.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
     const double eta = t > s.t_start ? elapsed * (s.t_end - t) / (t - s.t_start) : 0.0;

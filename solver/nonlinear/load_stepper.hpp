@@ -4,6 +4,10 @@
 // and cut; easy steps let the step grow. Steps end exactly on `stops` (phase
 // ends, output times).
 //
+// Predictor (NewtonSettings::predictor): each attempt starts from the last
+// converged step's increment scaled by h / h_last, a secant extrapolation of
+// the load path; newton_step keeps it only where it lowers the residual.
+//
 // Stall rule (DESIGN.md §7, issue 11 "Stability"): the stepper gives up when
 //  - a cut would go below dt_min, or
 //  - one step needed more than max_cuts cuts, or
@@ -34,6 +38,9 @@ struct StepperSettings {
   int easy_iterations = 5;     // grow after a step with at most this many Newton iterations
   std::vector<double> stops;   // times a step must end on
   int first_step = 0;          // steps done before t_start (restart: numbering continues)
+  /// The predictor's start (restart): the last converged step's increment and size.
+  Eigen::VectorXd last_increment;
+  double last_dt = 0.0;
   /// Describes the load at pseudo-time t for the stall message, e.g.
   /// "p = 0.193 MPa (load factor 0.667)"; default "t = ...".
   std::function<std::string(double)> describe_load;
@@ -57,6 +64,8 @@ struct StepRecord {
   double wall_seconds = 0.0, assembly_seconds = 0.0, linear_seconds = 0.0;
   double linear_setup_seconds = 0.0;  // part of linear_seconds: matrix build, factorization / preconditioner
   double next_dt = 0.0;        // the step size the stepper tries next (restart resumes with it)
+  bool predicted = false;      // the converged attempt started from the predictor's guess
+  Eigen::VectorXd increment;   // the step's increment (the next step's predictor; checkpointed)
   std::vector<double> residual_norms;
 };
 

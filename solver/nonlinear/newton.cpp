@@ -24,7 +24,7 @@ double reaction_norm(const Constraints& c, const Eigen::VectorXd& r) {
 }  // namespace
 
 NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linear, Eigen::VectorXd& u, double time,
-                         double dt, const NewtonSettings& settings) {
+                         double dt, const NewtonSettings& settings, const Eigen::VectorXd* guess) {
   NewtonResult res;
   const Eigen::VectorXd u_start = u;
   auto fail = [&](std::string why) {
@@ -33,15 +33,73 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     return res;
   };
   Eigen::VectorXd prescribed = model.constraints.increments(u, time);
+  const bool try_guess = guess && guess->size() == u.size() && guess->squaredNorm() > 0.0;
   auto t0 = Clock::now();
   try {
-    model.assemble(u, time, dt, prescribed, system, true);
+    model.assemble(u, time, dt, prescribed, system, !try_guess);
   } catch (const ElementFailure& e) {
     return fail(e.what());
   }
   res.assembly_seconds += since(t0);
   double r_norm = system.free_residual_norm();
   double scale = std::max(r_norm, reaction_norm(model.constraints, system.residual()));
+  res.increment = Eigen::VectorXd::Zero(u.size());
+  if (try_guess) {
+    // The guess moves free DOFs only: fixed ones reach their values through the first solve.
+    Eigen::VectorXd g_local = *guess;
+    model.constraints.to_local(g_local);
+    for (GlobalDof d = 0; d < g_local.size(); ++d)
+      if (model.constraints.fixed(d)) g_local(d) = 0.0;
+    // The potential's slope along the guess, E'(a) = R(u + a g) . g, judges it (a residual
+    // norm would not: a guess ten times closer to the solution can have a larger residual in
+    // the stiff directions the converged state has in balance). E'(0) >= 0: the guess points
+    // against the load (it reversed). Otherwise the secant minimizer a* = E'(0) / (E'(0) - E'(1))
+    // scales a guess that overshoots by more than twice.
+    const double s0 = system.residual().dot(g_local);
+    double scale_guess = s0 < 0.0 ? 1.0 : 0.0;
+    bool kept = false;
+    for (int attempt = 0; attempt < 2 && scale_guess > 0.0; ++attempt) {
+      Eigen::VectorXd g = scale_guess * g_local;
+      model.constraints.to_global(g);
+      model.trial(g);
+      const Eigen::VectorXd u_guess = u + g;
+      t0 = Clock::now();
+      try {
+        model.assemble(u_guess, time, dt, prescribed, system, true);
+      } catch (const ElementFailure& e) {
+        log::debug("  predictor: {} at the guess", e.what());
+        res.assembly_seconds += since(t0);
+        break;
+      }
+      res.assembly_seconds += since(t0);
+      const double r_guess = system.free_residual_norm();
+      if (!std::isfinite(r_guess)) break;
+      const double s1 = system.residual().dot(g_local) * scale_guess;
+      const double a_star = s1 > s0 * scale_guess ? -s0 * scale_guess / (s1 - s0 * scale_guess) : 1.0;
+      if (attempt == 0 && a_star < 0.5) {
+        scale_guess *= a_star;
+        continue;
+      }
+      u = u_guess;
+      res.increment = g;
+      res.predicted = kept = true;
+      log::debug("  predictor: guess x {:.3g}, |R| = {:.3e} there, {:.3e} at the converged state", scale_guess, r_guess, r_norm);
+      r_norm = r_guess;
+      break;
+    }
+    if (!kept) {
+      if (s0 >= 0.0) log::debug("  predictor: the guess points against the load; starting from the converged state");
+      model.trial(Eigen::VectorXd::Zero(u.size()));
+      t0 = Clock::now();
+      try {
+        model.assemble(u, time, dt, prescribed, system, true);
+      } catch (const ElementFailure& e) {
+        return fail(e.what());
+      }
+      res.assembly_seconds += since(t0);
+    }
+    model.accept();
+  }
   res.residual_norms.push_back(r_norm);
 
   for (int it = 1; it <= settings.max_iterations; ++it) {
@@ -66,19 +124,25 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     model.constraints.to_global(du);
 
     // Backtracking line search on |R_free|; fixed DOFs always take their full increment.
+    // The full step is assembled with its tangent: when it is taken (the usual case near the
+    // solution) no second assembly is needed.
     Eigen::VectorXd du_fixed = prescribed;
     model.constraints.to_global(du_fixed);  // global-frame vector of the prescribed part
     double alpha = 1.0, best_norm = std::numeric_limits<double>::infinity(), best_alpha = 0.0;
     std::string last_failure;
     const Eigen::VectorXd u_it = u;
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(u.size());
+    double last_alpha = 0.0;   // the state the system holds (0: none evaluated)
+    bool last_tangent = false;  // ... and whether with its tangent
     for (int ls_step = 0; ls_step <= settings.line_search_steps; ++ls_step, alpha *= 0.5) {
       const Eigen::VectorXd step = alpha * (du - du_fixed) + du_fixed;
       const Eigen::VectorXd u_try = u_it + step;
       model.trial(step);
-      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(u.size());
       t0 = Clock::now();
+      const bool with_tangent = ls_step == 0;
+      last_alpha = 0.0;
       try {
-        model.assemble(u_try, time, dt, zero, system, false);
+        model.assemble(u_try, time, dt, zero, system, with_tangent);
       } catch (const ElementFailure& e) {
         last_failure = e.what();
         res.assembly_seconds += since(t0);
@@ -90,23 +154,29 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
         last_failure = "non-finite residual";
         continue;
       }
+      last_alpha = alpha, last_tangent = with_tangent;
       if (n_try < best_norm) best_norm = n_try, best_alpha = alpha;
       if (n_try <= (1.0 - 1e-4 * alpha) * r_norm) break;
     }
     if (best_alpha == 0.0) return fail(last_failure.empty() ? "line search found no admissible state" : last_failure);
     const Eigen::VectorXd step = best_alpha * (du - du_fixed) + du_fixed;
     u = u_it + step;
-    model.trial(step);
-    model.accept();
+    res.increment += step;
     prescribed.setZero();
-    // Tangent at the accepted state (also re-evaluates the residual there).
-    t0 = Clock::now();
-    try {
-      model.assemble(u, time, dt, prescribed, system, true);
-    } catch (const ElementFailure& e) {
-      return fail(e.what());
+    // Tangent at the accepted state (also re-evaluates the residual there), unless the
+    // system already holds it (the full step, taken). Terms see the accepted state's
+    // tangent assembly before accept(): contact counts active-set changes there.
+    if (!(last_tangent && last_alpha == best_alpha)) {
+      model.trial(step);
+      t0 = Clock::now();
+      try {
+        model.assemble(u, time, dt, prescribed, system, true);
+      } catch (const ElementFailure& e) {
+        return fail(e.what());
+      }
+      res.assembly_seconds += since(t0);
     }
-    res.assembly_seconds += since(t0);
+    model.accept();
     r_norm = system.free_residual_norm();
     scale = std::max(scale, reaction_norm(model.constraints, system.residual()));
     res.residual_norms.push_back(r_norm);

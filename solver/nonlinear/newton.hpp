@@ -3,6 +3,14 @@
 // free-DOF residual norm. A trial state that a term cannot evaluate
 // (ElementFailure: inverted element, overflow, NaN) is backtracked; if no
 // trial works the step fails and the stepper cuts it (DESIGN.md §7).
+//
+// Predictor: the step may start from the last converged state moved by a
+// guessed increment of its free DOFs (the stepper extrapolates the last
+// step's). It is kept only when it lowers the free residual below the one at
+// the converged state, so a load that reverses (inflation -> deflation) or a
+// guess that inverts an element costs one residual evaluation, never the step.
+// The force scale of the convergence test is the residual at the converged
+// state whether or not the guess is kept: a good guess must not tighten it.
 #include <Eigen/Core>
 
 #include <string>
@@ -20,6 +28,7 @@ struct NewtonSettings {
   double increment_tolerance = 1e-8;  // relative to |u|
   double increment_absolute = 0.0;    // |du| at or below this also satisfies the increment test (0: off)
   int line_search_steps = 6;          // halvings
+  bool predictor = true;              // the stepper starts each step from the last step's increment, extrapolated
 };
 
 struct NewtonResult {
@@ -29,12 +38,18 @@ struct NewtonResult {
   std::vector<double> residual_norms;  // free-DOF residual, per iteration (index 0 = before the first solve)
   std::string failure;                 // why it failed (last element failure or divergence)
   double assembly_seconds = 0.0, linear_seconds = 0.0;
+  bool predicted = false;              // the step started from the predictor's guess
+  /// The converged step's increment (additive DOFs exactly; rotational DOFs the
+  /// sum of their rotation-vector increments, a first-order guess).
+  Eigen::VectorXd increment;
   double linear_setup_seconds = 0.0;  // part of linear_seconds: matrix build, factorization / preconditioner
 };
 
 /// Solves the step ending at `time` (size dt) starting from u (updated in
-/// place on success; left at the start value on failure).
+/// place on success; left at the start value on failure). `guess`, when
+/// given and non-empty, is the predictor's increment (global frame; its
+/// components at fixed DOFs are ignored: those follow their prescribed values).
 NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linear, Eigen::VectorXd& u, double time,
-                         double dt, const NewtonSettings& settings);
+                         double dt, const NewtonSettings& settings, const Eigen::VectorXd* guess = nullptr);
 
 }  // namespace stentsim::solver
