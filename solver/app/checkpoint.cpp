@@ -27,13 +27,13 @@ SolverCheckpoint SolverCheckpoint::get(const HistoryArchive& in, long long dofs)
   c.counters.linear_iterations = static_cast<long>(in.get_scalar("solver/linear_iterations"));
   c.counters.step_cuts = static_cast<long>(in.get_scalar("solver/step_cuts"));
   c.counters.steps = static_cast<int>(in.get_scalar("solver/steps"));
-  c.counters.predicted_steps = static_cast<int>(in.get_scalar("solver/predicted_steps"));
-  const auto& inc = in.get("solver/last_increment");
-  if (!inc.empty()) {
-    const auto& sized = in.get("solver/last_increment", dofs);
-    c.last_increment = Eigen::Map<const Eigen::VectorXd>(sized.data(), static_cast<Eigen::Index>(sized.size()));
+  // Checkpoints written without a predictor state resume without a guess for their first step.
+  if (in.has("solver/predicted_steps")) c.counters.predicted_steps = static_cast<int>(in.get_scalar("solver/predicted_steps"));
+  if (in.has("solver/last_increment") && !in.get("solver/last_increment").empty()) {
+    const auto& inc = in.get("solver/last_increment", dofs);
+    c.last_increment = Eigen::Map<const Eigen::VectorXd>(inc.data(), static_cast<Eigen::Index>(inc.size()));
   }
-  c.last_dt = in.get_scalar("solver/last_dt");
+  if (in.has("solver/last_dt")) c.last_dt = in.get_scalar("solver/last_dt");
   return c;
 }
 

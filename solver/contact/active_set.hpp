@@ -5,7 +5,9 @@
 // between accepted iterates only, so a line-search trial that is assembled
 // with its tangent and then rejected adds no change (newton.hpp: the full
 // step is assembled with its tangent; Term::accept follows the accepted
-// state's tangent assembly).
+// state's tangent assembly). A trial whose acceptance would exceed the limit
+// is itself inadmissible (the pair throws there), so the line search backs off
+// from a full step that would chatter.
 #include <string>
 #include <vector>
 

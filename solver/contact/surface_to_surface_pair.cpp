@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <iterator>
 #include <cmath>
 #include <map>
 
@@ -80,7 +79,7 @@ SurfaceToSurfacePair::SurfaceToSurfacePair(std::string name, std::unique_ptr<Con
     gauss_.push_back(std::move(g));
   }
   active_.resize(slave_->num_nodes());
-  reserved_.assign(slave_->faces().size(), {});
+  reserved_.assign(slave_->num_nodes(), {});
 }
 
 void SurfaceToSurfacePair::search(const ContactSurface& slave, const ContactSurface& master, Candidates& out) const {
@@ -355,17 +354,6 @@ void SurfaceToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       done[static_cast<std::size_t>(fi)] = 1;
     }
   }
-  // The global pattern only grows: a slave node needs its pattern reserved again only when one
-  // of its faces has a master candidate that no earlier search gave it.
-  std::vector<char> fresh;
-  if (tangent && !pattern_reserved_) {
-    fresh.assign(slave_->faces().size(), 0);
-    for (std::size_t f = 0; f < fresh.size(); ++f) {
-      const std::vector<int>& done = reserved_[f];
-      for (int mf : candidates_[f])
-        if (!std::binary_search(done.begin(), done.end(), mf)) fresh[f] = 1;
-    }
-  }
   for (std::size_t j = 0; j < ns; ++j) {
     if (!state.owns(j, ns)) continue;
     const NodeResult r = assemble_node(*slave_, *master_, static_cast<int>(j), gaps, tangent, &out);
@@ -377,21 +365,21 @@ void SurfaceToSurfacePair::assemble(const SystemState& state, Assembler& out) {
                                          slave_->body().name(), changes, settings_.max_flips));
     }
     if (tangent && !pattern_reserved_) {
-      const auto& faces = slave_->node_faces(static_cast<int>(j));
-      if (std::none_of(faces.begin(), faces.end(), [&](int fi) { return fresh[static_cast<std::size_t>(fi)] != 0; })) continue;
+      // The global pattern only grows, and a node's block couples all the master faces its
+      // faces may hit: reserved again only when they are not all in the block reserved last.
+      std::vector<int> masters;
+      for (int fi : slave_->node_faces(static_cast<int>(j)))
+        masters.insert(masters.end(), candidates_[static_cast<std::size_t>(fi)].begin(), candidates_[static_cast<std::size_t>(fi)].end());
+      std::sort(masters.begin(), masters.end());
+      masters.erase(std::unique(masters.begin(), masters.end()), masters.end());
+      std::vector<int>& last = reserved_[j];
+      if (std::includes(last.begin(), last.end(), masters.begin(), masters.end())) continue;
       const std::vector<GlobalDof> dofs = candidate_dofs(static_cast<int>(j));
       const auto n = static_cast<Eigen::Index>(dofs.size());
       if (n > 0) out.add(dofs, Eigen::VectorXd::Zero(n), Eigen::MatrixXd::Zero(n, n));
+      last.swap(masters);
     }
   }
-  if (tangent && !pattern_reserved_)
-    for (std::size_t f = 0; f < fresh.size(); ++f) {
-      if (!fresh[f]) continue;
-      std::vector<int> now = candidates_[f], merged;
-      std::sort(now.begin(), now.end());
-      std::set_union(reserved_[f].begin(), reserved_[f].end(), now.begin(), now.end(), std::back_inserter(merged));
-      reserved_[f].swap(merged);
-    }
   if (tangent) pattern_reserved_ = true;
 }
 

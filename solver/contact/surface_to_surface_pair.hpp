@@ -158,7 +158,7 @@ class SurfaceToSurfacePair : public Term {
   Candidates candidates_;
   std::vector<Vec3> searched_slave_, searched_master_;
   bool pattern_reserved_ = false;
-  Candidates reserved_;  // per slave face, the master faces whose pattern was reserved (sorted)
+  Candidates reserved_;  // per slave node, the master faces of the block reserved last (sorted)
   ActiveSet active_;  // per slave node
   long long searches_ = 0;
 };

@@ -6,7 +6,7 @@
 //
 // Predictor (NewtonSettings::predictor): each attempt starts from the last
 // converged step's increment scaled by h / h_last, a secant extrapolation of
-// the load path; newton_step keeps it only where it lowers the residual.
+// the load path; newton_step judges it (newton.hpp).
 //
 // Stall rule (DESIGN.md §7, issue 11 "Stability"): the stepper gives up when
 //  - a cut would go below dt_min, or

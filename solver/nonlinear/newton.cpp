@@ -33,7 +33,9 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     return res;
   };
   Eigen::VectorXd prescribed = model.constraints.increments(u, time);
-  const bool try_guess = guess && guess->size() == u.size() && guess->squaredNorm() > 0.0;
+  // Only for steps that no prescribed DOF drives: with fixed DOFs still at their old values the
+  // slope test below would judge the guess against the wrong state.
+  const bool try_guess = guess && guess->size() == u.size() && guess->squaredNorm() > 0.0 && prescribed.squaredNorm() == 0.0;
   auto t0 = Clock::now();
   try {
     model.assemble(u, time, dt, prescribed, system, !try_guess);
@@ -78,6 +80,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
       const double a_star = s1 > s0 * scale_guess ? -s0 * scale_guess / (s1 - s0 * scale_guess) : 1.0;
       if (attempt == 0 && a_star < 0.5) {
         scale_guess *= a_star;
+        if (scale_guess < 0.05) break;  // next to nothing left of the guess: start from the converged state
         continue;
       }
       u = u_guess;
@@ -88,7 +91,8 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
       break;
     }
     if (!kept) {
-      if (s0 >= 0.0) log::debug("  predictor: the guess points against the load; starting from the converged state");
+      log::debug("  predictor: {}; starting from the converged state",
+                 s0 >= 0.0 ? "the guess points against the load" : "the guess does not help");
       model.trial(Eigen::VectorXd::Zero(u.size()));
       t0 = Clock::now();
       try {

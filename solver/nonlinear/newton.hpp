@@ -4,13 +4,15 @@
 // (ElementFailure: inverted element, overflow, NaN) is backtracked; if no
 // trial works the step fails and the stepper cuts it (DESIGN.md §7).
 //
-// Predictor: the step may start from the last converged state moved by a
-// guessed increment of its free DOFs (the stepper extrapolates the last
-// step's). It is kept only when it lowers the free residual below the one at
-// the converged state, so a load that reverses (inflation -> deflation) or a
-// guess that inverts an element costs one residual evaluation, never the step.
-// The force scale of the convergence test is the residual at the converged
-// state whether or not the guess is kept: a good guess must not tighten it.
+// Predictor: a step that no prescribed DOF drives may start from the last
+// converged state moved by a guessed increment of its free DOFs (the stepper
+// extrapolates the last step's). The potential's slope along the guess judges
+// it: a guess that points against the load (a reversed load, deflation after
+// inflation) is dropped, one that overshoots is shortened by a secant step,
+// one that inverts an element is dropped. A dropped guess costs one or two
+// extra assemblies, never the step. The force scale of the convergence test is
+// the residual at the converged state whether or not the guess is kept: a good
+// guess must not tighten it.
 #include <Eigen/Core>
 
 #include <string>

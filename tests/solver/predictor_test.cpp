@@ -115,6 +115,22 @@ TEST(SolverPredictor, AReversedLoadDropsTheGuess) {
   EXPECT_LT((a.u - b.u).norm(), 1e-9 * b.u.norm());
 }
 
+TEST(SolverPredictor, NoGuessForAStepThatPrescribedDofsDrive) {
+  // The top pressed down by prescribed displacements (no pressure): the slope test would judge a
+  // guess with the fixed DOFs at their old values, so no guess is made and the result is the same.
+  auto with = make_block(0.0, LoadCurve::ramp(0, 1));
+  auto without = make_block(0.0, LoadCurve::ramp(0, 1));
+  for (Block* b : {with.get(), without.get()})
+    for (std::size_t i = 0; i < b->body->num_nodes(); ++i)
+      if (b->body->mesh().points[i].z() > 2 - 1e-9)
+        b->model.constraints.fix(b->body->dof(i, 2), [](double t) { return -0.3 * t; });
+  const StepperRun a = run(*with, 1.0, 0.25, true), b = run(*without, 1.0, 0.25, false);
+  ASSERT_EQ(a.steps, 4);
+  EXPECT_EQ(a.predicted, 0);
+  EXPECT_EQ(a.newton, b.newton);
+  EXPECT_LT((a.u - b.u).norm(), 1e-12 * b.u.norm());
+}
+
 TEST(SolverPredictor, TheTakenFullStepIsAssembledOnce) {
   // A small load: every Newton step is taken in full, so each iteration assembles once
   // (the full step with its tangent), plus the converged state's residual at the step's start.

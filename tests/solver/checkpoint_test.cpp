@@ -1,0 +1,52 @@
+// The solver's part of checkpoint.bin: every named field back as written, the
+// predictor's state included, and a checkpoint without that state (written
+// before the predictor existed) read as "no guess for the first step".
+#include <gtest/gtest.h>
+
+#include "common/error.hpp"
+#include "solver/app/checkpoint.hpp"
+
+namespace stentsim::solver {
+namespace {
+
+TEST(SolverCheckpoint, RoundTripKeepsThePredictorState) {
+  SolverCheckpoint c;
+  c.u = Eigen::VectorXd::LinSpaced(5, 0.0, 1.0);
+  c.time = 0.75, c.next_dt = 0.02, c.last_dt = 0.01;
+  c.last_increment = Eigen::VectorXd::Constant(5, 0.125);
+  c.counters.newton_iterations = 40, c.counters.linear_iterations = 41, c.counters.step_cuts = 2;
+  c.counters.steps = 9, c.counters.predicted_steps = 7;
+  HistoryArchive a;
+  c.put(a);
+  const SolverCheckpoint r = SolverCheckpoint::get(a, 5);
+  EXPECT_EQ(r.u, c.u);
+  EXPECT_EQ(r.last_increment, c.last_increment);
+  EXPECT_EQ(r.time, 0.75);
+  EXPECT_EQ(r.next_dt, 0.02);
+  EXPECT_EQ(r.last_dt, 0.01);
+  EXPECT_EQ(r.counters.steps, 9);
+  EXPECT_EQ(r.counters.predicted_steps, 7);
+  EXPECT_EQ(r.counters.step_cuts, 2);
+  EXPECT_THROW(SolverCheckpoint::get(a, 6), InputError);  // another model
+}
+
+TEST(SolverCheckpoint, WithoutPredictorStateResumesWithoutAGuess) {
+  SolverCheckpoint c;
+  c.u = Eigen::VectorXd::Ones(3);
+  HistoryArchive a;
+  c.put(a);  // an empty last increment: the first step of a run
+  SolverCheckpoint r = SolverCheckpoint::get(a, 3);
+  EXPECT_EQ(r.last_increment.size(), 0);
+  HistoryArchive old;
+  for (const char* k : {"solver/time", "solver/next_dt", "solver/newton_iterations", "solver/linear_iterations",
+                        "solver/step_cuts", "solver/steps"})
+    old.put(k, 1.0);
+  old.put("solver/u", std::span<const double>(c.u.data(), 3));
+  r = SolverCheckpoint::get(old, 3);
+  EXPECT_EQ(r.last_increment.size(), 0);
+  EXPECT_EQ(r.last_dt, 0.0);
+  EXPECT_EQ(r.counters.predicted_steps, 0);
+}
+
+}  // namespace
+}  // namespace stentsim::solver
