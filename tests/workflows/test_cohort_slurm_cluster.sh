@@ -80,10 +80,14 @@ EOF
 export SLURM_CONF=$B/slurm.conf
 mungekey --create --keyfile="$B/munge/munge.key" >/dev/null 2>&1 || { echo "mungekey failed"; exit 1; }
 setsid munged -F --socket="$B/munge/munge.socket.2" --key-file="$B/munge/munge.key" --log-file="$B/log/munged.log" \
-  --pid-file="$B/munge/munged.pid" --seed-file="$B/munge/munged.seed" </dev/null >/dev/null 2>&1 &
+  --pid-file="$B/munge/munged.pid" --seed-file="$B/munge/munged.seed" </dev/null >"$B/log/munged.out" 2>&1 &
 echo $! > "$B/pids"
 for _ in $(seq 1 100); do [ -S "$B/munge/munge.socket.2" ] && break; sleep 0.05; done
-[ -S "$B/munge/munge.socket.2" ] || { echo "munged did not start: $(tail -3 "$B/log/munged.log")"; stop; exit 1; }
+# munged refuses a socket below a folder that others cannot enter (a build under mktemp -d's 0700 folder).
+[ -S "$B/munge/munge.socket.2" ] || {
+  echo "munged did not start: $(tail -3 "$B/log/munged.out" "$B/log/munged.log" 2>/dev/null)"
+  echo "(munged needs every folder above $B to be searchable by all: chmod o+x on the one it names)"
+  stop; exit 1; }
 setsid slurmctld -D -c -f "$SLURM_CONF" </dev/null >"$B/log/slurmctld.out" 2>&1 &
 echo $! >> "$B/pids"
 # slurmd (and so every job) in a private mount namespace with B/hidden over-mounted;
