@@ -32,17 +32,23 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     u = u_start;
     return res;
   };
+  // One timed assembly at v; the failure of a term that cannot evaluate v, empty on success.
+  auto assemble_at = [&](const Eigen::VectorXd& v, const Eigen::VectorXd& presc, bool tangent) -> std::string {
+    const auto start = Clock::now();
+    std::string failure;
+    try {
+      model.assemble(v, time, dt, presc, system, tangent);
+    } catch (const ElementFailure& e) {
+      failure = e.what();
+    }
+    res.assembly_seconds += since(start);
+    return failure;
+  };
   Eigen::VectorXd prescribed = model.constraints.increments(u, time);
   // Only for steps that no prescribed DOF drives: with fixed DOFs still at their old values the
   // slope test below would judge the guess against the wrong state.
   const bool try_guess = guess && guess->size() == u.size() && guess->squaredNorm() > 0.0 && prescribed.squaredNorm() == 0.0;
-  auto t0 = Clock::now();
-  try {
-    model.assemble(u, time, dt, prescribed, system, !try_guess);
-  } catch (const ElementFailure& e) {
-    return fail(e.what());
-  }
-  res.assembly_seconds += since(t0);
+  if (std::string e = assemble_at(u, prescribed, !try_guess); !e.empty()) return fail(e);
   double r_norm = system.free_residual_norm();
   double scale = std::max(r_norm, reaction_norm(model.constraints, system.residual()));
   res.increment = Eigen::VectorXd::Zero(u.size());
@@ -65,15 +71,10 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
       model.constraints.to_global(g);
       model.trial(g);
       const Eigen::VectorXd u_guess = u + g;
-      t0 = Clock::now();
-      try {
-        model.assemble(u_guess, time, dt, prescribed, system, true);
-      } catch (const ElementFailure& e) {
-        log::debug("  predictor: {} at the guess", e.what());
-        res.assembly_seconds += since(t0);
+      if (std::string e = assemble_at(u_guess, prescribed, true); !e.empty()) {
+        log::debug("  predictor: {} at the guess", e);
         break;
       }
-      res.assembly_seconds += since(t0);
       const double r_guess = system.free_residual_norm();
       if (!std::isfinite(r_guess)) break;
       const double s1 = system.residual().dot(g_local) * scale_guess;
@@ -94,13 +95,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
       log::debug("  predictor: {}; starting from the converged state",
                  s0 >= 0.0 ? "the guess points against the load" : "the guess does not help");
       model.trial(Eigen::VectorXd::Zero(u.size()));
-      t0 = Clock::now();
-      try {
-        model.assemble(u, time, dt, prescribed, system, true);
-      } catch (const ElementFailure& e) {
-        return fail(e.what());
-      }
-      res.assembly_seconds += since(t0);
+      if (std::string e = assemble_at(u, prescribed, true); !e.empty()) return fail(e);
     }
     model.accept();
   }
@@ -110,7 +105,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     res.iterations = it;
     // Linear solve in local (frame) coordinates, then back to global.
     Eigen::VectorXd du;
-    t0 = Clock::now();
+    const auto t0 = Clock::now();
     LinearSolveStats ls;
     try {
       ls = linear.solve(system.matrix(), system.rhs(), du);
@@ -142,17 +137,12 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
       const Eigen::VectorXd step = alpha * (du - du_fixed) + du_fixed;
       const Eigen::VectorXd u_try = u_it + step;
       model.trial(step);
-      t0 = Clock::now();
       const bool with_tangent = ls_step == 0;
       last_alpha = 0.0;
-      try {
-        model.assemble(u_try, time, dt, zero, system, with_tangent);
-      } catch (const ElementFailure& e) {
-        last_failure = e.what();
-        res.assembly_seconds += since(t0);
+      if (std::string e = assemble_at(u_try, zero, with_tangent); !e.empty()) {
+        last_failure = std::move(e);
         continue;
       }
-      res.assembly_seconds += since(t0);
       const double n_try = system.free_residual_norm();
       if (!std::isfinite(n_try)) {
         last_failure = "non-finite residual";
@@ -172,13 +162,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     // tangent assembly before accept(): contact counts active-set changes there.
     if (!(last_tangent && last_alpha == best_alpha)) {
       model.trial(step);
-      t0 = Clock::now();
-      try {
-        model.assemble(u, time, dt, prescribed, system, true);
-      } catch (const ElementFailure& e) {
-        return fail(e.what());
-      }
-      res.assembly_seconds += since(t0);
+      if (std::string e = assemble_at(u, prescribed, true); !e.empty()) return fail(e);
     }
     model.accept();
     r_norm = system.free_residual_norm();
