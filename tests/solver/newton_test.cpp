@@ -13,42 +13,17 @@
 #include "solver/nonlinear/load_stepper.hpp"
 #include "solver/terms/follower_pressure.hpp"
 #include "solver/terms/robin_springs.hpp"
+#include "tests/solver/neo_hooke_block.hpp"
 
 namespace stentsim::solver {
 namespace {
 
-struct Block {
-  Model model;
-  SolidBody* body = nullptr;
-};
-
-// A 1 x 1 x 2 block of neo-Hooke on springs at z = 0, follower pressure on z = 2.
-std::unique_ptr<Block> make_block(MeshData mesh, double pressure) {
-  auto b = std::make_unique<Block>();
-  SolidBodySpec spec;
-  spec.name = "block";
-  spec.mesh = std::move(mesh);
-  Material m;
-  m.name = "nh";
-  m.matrix = CoupledNeoHooke::from_young_poisson(1.0, 0.3);
-  spec.materials = {m};
-  spec.cell_material.assign(spec.mesh.num_cells(), 0);
-  const GlobalDof first = b->model.dofs.allocate("block", 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
-  b->body = &b->model.add_term<SolidBody>(spec, first);
-  std::vector<fem::Face> bottom, top;
-  for (const auto& f : fem::boundary_faces(b->body->mesh())) {
-    double zmax = -1, zmin = 10;
-    for (int i = 0; i < f.count; ++i) {
-      zmax = std::max(zmax, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
-      zmin = std::min(zmin, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
-    }
-    if (zmax < 1e-9) bottom.push_back(f);
-    if (zmin > 2 - 1e-9) top.push_back(f);
-  }
-  b->model.add_term<RobinSprings>("springs", *b->body, bottom, 100.0);
-  b->model.add_term<FollowerPressure>("pressure", *b->body, top, pressure, LoadCurve::ramp(0, 1));
+// The block on springs at z = 0, follower pressure on z = 2.
+std::unique_ptr<NeoHookeBlock> make_block(MeshData mesh, double pressure) {
+  auto b = make_neo_hooke_block(std::move(mesh));
+  b->model.add_term<RobinSprings>("springs", *b->body, b->bottom, 100.0);
+  b->model.add_term<FollowerPressure>("pressure", *b->body, b->top, pressure, LoadCurve::ramp(0, 1));
   b->model.size_constraints();
-  // remove the rigid in-plane motion left by springs? springs are omnidirectional: none left.
   return b;
 }
 

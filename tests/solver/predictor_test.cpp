@@ -12,6 +12,7 @@
 #include "solver/nonlinear/load_stepper.hpp"
 #include "solver/terms/follower_pressure.hpp"
 #include "solver/terms/robin_springs.hpp"
+#include "tests/solver/neo_hooke_block.hpp"
 
 namespace stentsim::solver {
 namespace {
@@ -28,39 +29,22 @@ class CountingTerm : public Term {
 };
 
 struct Block {
-  Model model;
-  SolidBody* body = nullptr;
-  CountingTerm* counter = nullptr;
+  std::unique_ptr<NeoHookeBlock> block;
+  Model& model;
+  SolidBody* body;
+  CountingTerm* counter;
 };
 
-// A 1 x 1 x 2 neo-Hooke block on springs at z = 0, follower pressure on z = 2 following `curve`.
+// The block on springs at z = 0, follower pressure on z = 2 following `curve`.
 std::unique_ptr<Block> make_block(double pressure, LoadCurve curve) {
-  auto b = std::make_unique<Block>();
-  SolidBodySpec spec;
-  spec.name = "block";
-  spec.mesh = box_hex8(2, 2, 4, 1.0, 1.0, 2.0);
-  Material m;
-  m.name = "nh";
-  m.matrix = CoupledNeoHooke::from_young_poisson(1.0, 0.3);
-  spec.materials = {m};
-  spec.cell_material.assign(spec.mesh.num_cells(), 0);
-  const GlobalDof first = b->model.dofs.allocate("block", 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
-  b->body = &b->model.add_term<SolidBody>(spec, first);
-  std::vector<fem::Face> bottom, top;
-  for (const auto& f : fem::boundary_faces(b->body->mesh())) {
-    double zmax = -1, zmin = 10;
-    for (int i = 0; i < f.count; ++i) {
-      zmax = std::max(zmax, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
-      zmin = std::min(zmin, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
-    }
-    if (zmax < 1e-9) bottom.push_back(f);
-    if (zmin > 2 - 1e-9) top.push_back(f);
-  }
-  b->model.add_term<RobinSprings>("springs", *b->body, bottom, 100.0);
-  b->model.add_term<FollowerPressure>("pressure", *b->body, top, pressure, std::move(curve));
-  b->counter = &b->model.add_term<CountingTerm>();
-  b->model.size_constraints();
-  return b;
+  auto nb = make_neo_hooke_block(box_hex8(2, 2, 4, 1.0, 1.0, 2.0));
+  nb->model.add_term<RobinSprings>("springs", *nb->body, nb->bottom, 100.0);
+  nb->model.add_term<FollowerPressure>("pressure", *nb->body, nb->top, pressure, std::move(curve));
+  CountingTerm& counter = nb->model.add_term<CountingTerm>();
+  nb->model.size_constraints();
+  SolidBody* body = nb->body;
+  Model& model = nb->model;
+  return std::make_unique<Block>(Block{std::move(nb), model, body, &counter});
 }
 
 struct StepperRun {

@@ -23,41 +23,17 @@
 #include "solver/io/generated_meshes.hpp"
 #include "solver/nonlinear/load_stepper.hpp"
 #include "solver/terms/follower_pressure.hpp"
+#include "tests/solver/neo_hooke_block.hpp"
 
 namespace stentsim::solver {
 namespace {
 
-struct Block {
-  Model model;
-  SolidBody* body = nullptr;
-};
-
-// A 1 x 1 x 2 neo-Hooke block (E = 1 MPa, nu = 0.3) in uniaxial strain, clamped
-// at z = 0, follower pressure p on z = 2. At p = 2.5 MPa the first Newton
-// increment from u = 0 (the linear solution, strain p / 1.35 MPa) compresses
-// the block by more than its length: J <= 0.
-std::unique_ptr<Block> make_block(double pressure) {
-  auto b = std::make_unique<Block>();
-  SolidBodySpec spec;
-  spec.name = "block";
-  spec.mesh = box_hex8(1, 1, 2, 1.0, 1.0, 2.0);
-  Material m;
-  m.name = "nh";
-  m.matrix = CoupledNeoHooke::from_young_poisson(1.0, 0.3);
-  spec.materials = {m};
-  spec.cell_material.assign(spec.mesh.num_cells(), 0);
-  const GlobalDof first = b->model.dofs.allocate("block", 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
-  b->body = &b->model.add_term<SolidBody>(spec, first);
-  std::vector<fem::Face> top;
-  for (const auto& f : fem::boundary_faces(b->body->mesh())) {
-    double zmax = -1, zmin = 10;
-    for (int i = 0; i < f.count; ++i) {
-      zmax = std::max(zmax, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
-      zmin = std::min(zmin, b->body->mesh().points[static_cast<std::size_t>(f.nodes[i])].z());
-    }
-    if (zmin > 2 - 1e-9) top.push_back(f);
-  }
-  b->model.add_term<FollowerPressure>("pressure", *b->body, top, pressure, LoadCurve::ramp(0, 1));
+// The neo-Hooke block in uniaxial strain, clamped at z = 0, follower pressure p
+// on z = 2. At p = 2.5 MPa the first Newton increment from u = 0 (the linear
+// solution, strain p / 1.35 MPa) compresses the block by more than its length: J <= 0.
+std::unique_ptr<NeoHookeBlock> make_block(double pressure) {
+  auto b = make_neo_hooke_block(box_hex8(1, 1, 2, 1.0, 1.0, 2.0));
+  b->model.add_term<FollowerPressure>("pressure", *b->body, b->top, pressure, LoadCurve::ramp(0, 1));
   b->model.size_constraints();
   // Uniaxial strain: x, y held everywhere, bottom face clamped. (Free lateral
   // motion admits mirrored, everted equilibria with J > 0 that a one-step

@@ -137,6 +137,8 @@ TEST(SolverScene, BadInputNamesFileAndKey) {
   expect_error("type: direct", "type: gmres-amg", "did you mean 'gmres_amg'");
   expect_error("type: pressure", "type: presure", "did you mean 'pressure'");
   expect_error("every: 1", "evry: 1", "evry");
+  expect_error("newton: {max_iterations: 20,", "newton: {predictor: extrapolat, max_iterations: 20,",
+               "solver.newton.predictor: 'extrapolat' is not one of: extrapolate, none (did you mean 'extrapolate'?)");
   std::filesystem::remove_all(dir);
 }
 
