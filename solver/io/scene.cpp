@@ -49,7 +49,8 @@ MeshData read_mesh(ConfigMap& m, std::string& source) {
     const int nr = g.integer("radial", std::nullopt, Range{1.0, 1e4});
     const int nt = g.integer("circumferential", std::nullopt, Range{1.0, 1e5});
     const int nz = g.integer("axial", 1, Range{1.0, 1e5});
-    if (angle == 360.0) g.fail("angle_deg", "a closed ring is not generated (duplicate seam nodes); use < 360 with symmetry conditions");
+    // 360 deg closes the ring: the seam's nodes are shared.
+    if (angle == 360.0 && nt < 3) g.fail("circumferential", "a closed ring needs at least 3 elements around");
     mesh = ring_sector_hex8(ri, ro, angle * std::numbers::pi / 180.0, height, nr, nt, nz);
     source = fmt::format("generated ring sector {}x{}x{} {}", nr, nt, nz, element);
   } else {
@@ -81,6 +82,15 @@ Material read_material(ConfigMap& m) {
     mat.matrix = CoupledNeoHooke::from_young_poisson(e, nu);
     nh->finish();
   }
+  // svMultiPhysics's HGO: decoupled neo-Hooke matrix, and the fibers on Ibar4.
+  if (auto dh = m.optional_map("decoupled_hgo")) {
+    if (mat.matrix)
+      m.fail("decoupled_hgo", "replaces the coupled neo-Hooke matrix: drop 'neo_hooke' (and 'preset') from this material");
+    const double e = dh->quantity("E", units::kPressure, std::nullopt, Range::positive());
+    const double nu = dh->number("nu", std::nullopt, Range{-1.0, 0.5, false, false});
+    mat.decoupled_matrix = DecoupledNeoHooke::from_young_poisson(e, nu);
+    dh->finish();
+  }
   if (m.has("fibers")) {
     mat.fibers.clear();
     for (auto& f : m.map_list("fibers")) {
@@ -89,6 +99,7 @@ Material read_material(ConfigMap& m) {
       s.law.k2 = f.number("k2", std::nullopt, Range::non_negative());
       s.law.tension_only = f.boolean("tension_only", false);
       s.law.multiplicity = f.number("count", 1.0, Range::positive());
+      s.law.isochoric = mat.decoupled_matrix.has_value();
       if (f.has("direction")) s.global_direction = vec3(f, "direction").normalized();
       else s.angle_deg = f.number("angle_deg", 0.0, Range::between(-180, 180));
       f.finish();
@@ -105,7 +116,8 @@ Material read_material(ConfigMap& m) {
     else mat.viscous.reset();
     v->finish();
   }
-  if (!mat.matrix && mat.fibers.empty()) m.fail("", "a material needs a 'preset', 'neo_hooke' or 'fibers'");
+  if (!mat.matrix && !mat.decoupled_matrix && mat.fibers.empty())
+    m.fail("", "a material needs a 'preset', 'neo_hooke', 'decoupled_hgo' or 'fibers'");
   if (static_cast<int>(mat.fibers.size()) > kMaxFiberFamilies)
     m.fail("fibers", fmt::format("at most {} fiber families", kMaxFiberFamilies));
   return mat;

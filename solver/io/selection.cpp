@@ -39,7 +39,7 @@ std::vector<char> node_mask(const MeshData& mesh, const Selector& s) {
       case Selector::Kind::plane: in = std::abs((p - s.a).dot(s.b.normalized())) <= tol; break;
       case Selector::Kind::cylinder: {
         const Vec3 ax = s.b.normalized(), d = p - s.a;
-        in = std::abs((d - d.dot(ax) * ax).norm() - s.radius) <= tol;
+        in = std::abs((d - d.dot(ax) * ax).norm() - s.radius) <= tol && (!s.axial || std::abs(d.dot(ax) - *s.axial) <= tol);
         break;
       }
       case Selector::Kind::box: in = (p.array() >= s.a.array() - tol).all() && (p.array() <= s.b.array() + tol).all(); break;
@@ -57,7 +57,9 @@ std::string Selector::describe() const {
   switch (kind) {
     case Kind::all: return "all";
     case Kind::plane: return fmt::format("plane through ({:g},{:g},{:g}) normal ({:g},{:g},{:g})", a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
-    case Kind::cylinder: return fmt::format("cylinder radius {:g} about ({:g},{:g},{:g})+s({:g},{:g},{:g})", radius, a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
+    case Kind::cylinder:
+      return fmt::format("cylinder radius {:g} about ({:g},{:g},{:g})+s({:g},{:g},{:g}){}", radius, a.x(), a.y(), a.z(), b.x(), b.y(), b.z(),
+                         axial ? fmt::format(" at {:g} along it", *axial) : std::string());
     case Kind::box: return "box";
     case Kind::point_array: return fmt::format("point array {} = {:g}", array, value);
     case Kind::cell_array: return fmt::format("cell array {} = {:g}", array, value);
@@ -89,6 +91,7 @@ Selector read_selector(ConfigMap& cfg, const std::string& key) {
     s.b = vec(*p, "axis");
     if (s.b.norm() == 0) p->fail("axis", "must not be zero");
     s.radius = p->quantity("radius", units::kLength, std::nullopt, Range::positive());
+    if (p->has("at")) s.axial = p->quantity("at", units::kLength);
     s.tolerance = p->quantity("tolerance", units::kLength, -1.0);
     p->finish();
   }

@@ -6,6 +6,8 @@
 // `tension_only`: no contribution while I4 < 1 (fibers do not carry
 // compression; DESIGN.md §8 keeps the paper's both-ways form as default).
 // `multiplicity` counts coinciding families (two families at 0 deg count twice).
+// `isochoric`: the family acts on Ibar4 = J^(-2/3) I4 instead (the decoupled
+// HGO of svMultiPhysics; stress and tangent by isochoric_invariant.hpp).
 #include "solver/fem/tensor.hpp"
 #include "solver/materials/point_status.hpp"
 
@@ -16,6 +18,7 @@ struct FiberFamily {
   double k2 = 0.0;  // dimensionless
   bool tension_only = false;
   double multiplicity = 1.0;
+  bool isochoric = false;
 
   double energy(const Mat3& cauchy_green, const Vec3& m) const;
   /// Adds S and dS/dE (when `tangent` is not null) for the unit reference direction `m`.

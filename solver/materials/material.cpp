@@ -7,11 +7,14 @@ namespace stentsim::solver {
 PointStatus Material::elastic(const Mat3& cauchy_green, const Vec3* fiber_dirs, Vec6& stress, Mat6* tangent) const {
   stress.setZero();
   if (tangent) tangent->setZero();
-  if (matrix) {
+  if (matrix || decoupled_matrix) {
     const double j2 = cauchy_green.determinant();
     if (!(j2 > 0.0)) return PointStatus::fail("det C <= 0 (inverted element)");
     const Mat3 c_inv = cauchy_green.inverse();
-    if (auto s = matrix->add(cauchy_green, c_inv, std::sqrt(j2), stress, tangent); !s.ok) return s;
+    if (matrix)
+      if (auto s = matrix->add(cauchy_green, c_inv, std::sqrt(j2), stress, tangent); !s.ok) return s;
+    if (decoupled_matrix)
+      if (auto s = decoupled_matrix->add(cauchy_green, c_inv, std::sqrt(j2), stress, tangent); !s.ok) return s;
   }
   for (std::size_t f = 0; f < fibers.size(); ++f)
     if (auto s = fibers[f].law.add(cauchy_green, fiber_dirs[f], stress, tangent); !s.ok) return s;
@@ -22,6 +25,7 @@ PointStatus Material::elastic(const Mat3& cauchy_green, const Vec3* fiber_dirs, 
 double Material::energy(const Mat3& cauchy_green, const Vec3* fiber_dirs) const {
   double w = 0.0;
   if (matrix) w += matrix->energy(cauchy_green, std::sqrt(cauchy_green.determinant()));
+  if (decoupled_matrix) w += decoupled_matrix->energy(cauchy_green, std::sqrt(cauchy_green.determinant()));
   for (std::size_t f = 0; f < fibers.size(); ++f) w += fibers[f].law.energy(cauchy_green, fiber_dirs[f]);
   return w;
 }
@@ -31,8 +35,10 @@ std::string Material::describe() const {
   if (matrix)
     s += fmt::format(" coupled neo-Hooke c={:g} MPa beta={:g} (G={:g} MPa);", matrix->c, matrix->beta,
                      matrix->shear_modulus());
+  if (decoupled_matrix)
+    s += fmt::format(" decoupled neo-Hooke mu={:g} MPa K={:g} MPa;", decoupled_matrix->mu, decoupled_matrix->kappa);
   for (const auto& f : fibers) {
-    s += fmt::format(" fibers k1={:g} MPa k2={:g}", f.law.k1, f.law.k2);
+    s += fmt::format(" fibers{} k1={:g} MPa k2={:g}", f.law.isochoric ? " on Ibar4" : "", f.law.k1, f.law.k2);
     if (f.global_direction) s += fmt::format(" dir=({:g},{:g},{:g})", (*f.global_direction)(0), (*f.global_direction)(1), (*f.global_direction)(2));
     else s += fmt::format(" angle={:g} deg", f.angle_deg);
     s += f.law.tension_only ? " tension-only;" : ";";

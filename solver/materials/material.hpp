@@ -1,6 +1,7 @@
 #pragma once
 // A solid material: the sum of the strain-energy summands a body's cell tag
-// names (DESIGN.md §5): an optional coupled neo-Hooke matrix, any number of
+// names (DESIGN.md §5): an optional coupled neo-Hooke matrix or decoupled
+// neo-Hooke matrix (svMultiPhysics's HGO form), any number of
 // exponential fiber families (directions given per element by the body), and
 // an optional generalized-Maxwell viscous branch acting on the total
 // hyperelastic stress.
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "solver/materials/coupled_neo_hooke.hpp"
+#include "solver/materials/decoupled_neo_hooke.hpp"
 #include "solver/materials/fiber_family.hpp"
 #include "solver/materials/viscous_branch.hpp"
 
@@ -29,6 +31,7 @@ struct FiberFamilySpec {
 struct Material {
   std::string name;
   std::optional<CoupledNeoHooke> matrix;
+  std::optional<DecoupledNeoHooke> decoupled_matrix;
   std::vector<FiberFamilySpec> fibers;
   std::optional<ViscousBranch> viscous;
 

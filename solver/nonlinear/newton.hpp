@@ -27,7 +27,7 @@ struct NewtonSettings {
   int max_iterations = 20;
   double residual_tolerance = 1e-8;   // relative to the step's force scale
   double residual_absolute = 1e-10;   // N
-  double increment_tolerance = 1e-8;  // relative to |u|
+  double increment_tolerance = 1e-8;  // relative to |u|: the error left in the state, estimated from the contraction
   double increment_absolute = 0.0;    // |du| at or below this also satisfies the increment test (0: off)
   int line_search_steps = 6;          // halvings
   bool predictor = true;              // the stepper starts each step from the last step's increment, extrapolated

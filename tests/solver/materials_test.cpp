@@ -23,6 +23,20 @@ Mat3 random_f(std::mt19937& rng, double amplitude) {
   return f;
 }
 
+// svMultiPhysics's HGO (the peer tube's media): decoupled neo-Hooke, two families on Ibar4
+// (one acting both ways, one tension-only, at different directions).
+Material decoupled_hgo() {
+  Material m;
+  m.name = "decoupled HGO";
+  m.decoupled_matrix = DecoupledNeoHooke::from_young_poisson(0.1566, 0.45);
+  FiberFamilySpec f;
+  f.law = {0.64e-3, 3.54, false, 1.0, true};
+  FiberFamilySpec g;
+  g.law = {5.1e-3, 15.4, true, 1.0, true};
+  m.fibers = {f, g};
+  return m;
+}
+
 std::vector<Material> all_materials() {
   std::vector<Material> ms;
   Material nh;
@@ -39,6 +53,11 @@ std::vector<Material> all_materials() {
   fib.fibers = {f, f};
   ms.push_back(fib);
   for (const auto& p : material_preset_names()) ms.push_back(material_preset(p));
+  ms.push_back(decoupled_hgo());
+  Material dnh;
+  dnh.name = "decoupled neo-hooke nu=0";
+  dnh.decoupled_matrix = DecoupledNeoHooke::from_young_poisson(3.0, 0.0);
+  ms.push_back(dnh);
   return ms;
 }
 
@@ -129,6 +148,54 @@ TEST(SolverMaterials, SmallStrainLimitIsHooke) {
     EXPECT_NEAR(d(0, 0), lambda + 2 * mu, 1e-12);
     EXPECT_NEAR(d(0, 1), lambda, 1e-12);
     EXPECT_NEAR(d(3, 3), mu, 1e-12);
+  }
+}
+
+// Decoupled neo-Hooke at C = I: K 1 (x) 1 + 2 mu (II - 1/3 1 (x) 1), so lambda = K - 2 mu / 3.
+TEST(SolverMaterials, DecoupledSmallStrainLimitIsHooke) {
+  for (double nu : {0.0, 0.3, 0.45}) {
+    const double young = 2.5;
+    Material m;
+    m.decoupled_matrix = DecoupledNeoHooke::from_young_poisson(young, nu);
+    Vec6 s;
+    Mat6 d;
+    ASSERT_TRUE(m.elastic(Mat3::Identity(), nullptr, s, &d).ok);
+    EXPECT_LT(s.norm(), 1e-15);
+    const double lambda = young * nu / ((1 + nu) * (1 - 2 * nu)), mu = young / (2 * (1 + nu));
+    EXPECT_NEAR(d(0, 0), lambda + 2 * mu, 1e-12);
+    EXPECT_NEAR(d(0, 1), lambda, 1e-12);
+    EXPECT_NEAR(d(3, 3), mu, 1e-12);
+  }
+}
+
+// Decoupled HGO under a pure dilatation C = J^(2/3) 1: Ibar1 = 3 and Ibar4 = 1, so neither the
+// isochoric matrix nor the fibers (on Ibar4) stress it; S = K/2 (J^2 - 1) C^-1 alone. A fiber on
+// I4 would add 2 k1 (I4 - 1) exp(..) M (x) M.
+TEST(SolverMaterials, DecoupledHgoDilatationIsVolumetricOnly) {
+  const Material m = decoupled_hgo();
+  std::array<Vec3, kMaxFiberFamilies> dirs;
+  dirs.fill(Vec3(1, 2, 2) / 3.0);
+  for (double j : {0.9, 1.1, 1.4}) {
+    const Mat3 c = std::pow(j, 2.0 / 3.0) * Mat3::Identity();
+    Vec6 s;
+    ASSERT_TRUE(m.elastic(c, dirs.data(), s, nullptr).ok);
+    const double k = m.decoupled_matrix->kappa;
+    const Vec6 expected = to_voigt_stress(0.5 * k * (j * j - 1) * c.inverse());
+    EXPECT_LT((s - expected).norm(), 1e-14 * expected.norm()) << "J = " << j;
+  }
+  // Isochoric uniaxial stretch along the first fiber, F = diag(l, l^-1/2, l^-1/2): Ibar4 = I4 = l^2,
+  // sigma_11 - sigma_22 = mu (l^2 - 1/l) + 2 k1 (l^2 - 1) exp(k2 (l^2 - 1)^2) l^2.
+  dirs[0] = Vec3::UnitX();
+  dirs[1] = Vec3::UnitY();  // tension-only family in compression (I4 = 1/l < 1): nothing
+  for (double l : {1.05, 1.2}) {
+    const Mat3 f = Vec3(l, 1 / std::sqrt(l), 1 / std::sqrt(l)).asDiagonal();
+    Vec6 s;
+    ASSERT_TRUE(m.elastic(f.transpose() * f, dirs.data(), s, nullptr).ok);
+    const Mat3 sigma = cauchy_from_pk2(f, from_voigt_stress(s));
+    const double e = l * l - 1, k1 = m.fibers[0].law.k1, k2 = m.fibers[0].law.k2;
+    const double expected = m.decoupled_matrix->mu * (l * l - 1 / l) + 2 * k1 * e * std::exp(k2 * e * e) * l * l;
+    EXPECT_NEAR(sigma(0, 0) - sigma(1, 1), expected, 1e-13);
+    EXPECT_NEAR(sigma.trace(), 0.0, 1e-13);  // J = 1: no volumetric stress, and the isochoric parts are deviatoric
   }
 }
 

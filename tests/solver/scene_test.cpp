@@ -139,6 +139,9 @@ TEST(SolverScene, BadInputNamesFileAndKey) {
   expect_error("every: 1", "evry: 1", "evry");
   expect_error("newton: {max_iterations: 20,", "newton: {predictor: extrapolat, max_iterations: 20,",
                "solver.newton.predictor: 'extrapolat' is not one of: extrapolate, none (did you mean 'extrapolate'?)");
+  // The decoupled form replaces the coupled matrix: both in one material is an error that says which to drop.
+  expect_error("neo_hooke: {E: 1 MPa, nu: 0.45}", "neo_hooke: {E: 1 MPa, nu: 0.45}\n        decoupled_hgo: {E: 1 MPa, nu: 0.45}",
+               "decoupled_hgo: replaces the coupled neo-Hooke matrix: drop 'neo_hooke'");
   std::filesystem::remove_all(dir);
 }
 
