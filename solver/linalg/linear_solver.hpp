@@ -36,6 +36,8 @@ struct LinearSolverSettings {
   /// field such as the fibers' Laplace problems). Without a near-null space
   /// MueLu then uses the constant per component.
   int amg_equations_per_node = 3;
+  /// gmres_amg: a MueLu XML parameter list applied over ours (empty: none).
+  std::string amg_parameters;
   int verbosity = 0;
 };
 

@@ -13,6 +13,7 @@
 #include <MueLu_Hierarchy.hpp>
 #include <MueLu_TpetraOperator.hpp>
 #include <Teuchos_ParameterList.hpp>
+#include <Teuchos_XMLParameterListHelpers.hpp>
 #include <Tpetra_Core.hpp>
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Export.hpp>
@@ -72,6 +73,8 @@ class TrilinosSolver : public LinearSolver {
     if (settings_.type == LinearSolverType::gmres_ilu) o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
     else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space, symmetric Gauss-Seidel)";
     else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node, symmetric Gauss-Seidel)";
+    if (settings_.type == LinearSolverType::gmres_amg && !settings_.amg_parameters.empty())
+      o << ", MueLu parameters from " << settings_.amg_parameters;
     return o.str();
   }
 
@@ -311,6 +314,14 @@ class TrilinosSolver : public LinearSolver {
       Teuchos::ParameterList& sp = p.sublist("smoother: params");
       sp.set("relaxation: type", std::string("Symmetric Gauss-Seidel"));
       sp.set("relaxation: sweeps", 1);
+      if (!settings_.amg_parameters.empty()) {
+        // The user's MueLu list (e.g. "aggregation: drop tol", "smoother: type") over ours.
+        try {
+          Teuchos::updateParametersFromXmlFileAndBroadcast(settings_.amg_parameters, Teuchos::Ptr<Teuchos::ParameterList>(&p), *comm_);
+        } catch (const std::exception& e) {
+          throw InputError("linear.amg_parameters: " + settings_.amg_parameters + " is not a MueLu XML parameter list: " + e.what());
+        }
+      }
       check_near_null_space(static_cast<GO>(map->getGlobalNumElements()));
       if (modes_.size() > 0) {
         RCP<MV> ns = rcp(new MV(map, static_cast<std::size_t>(modes_.cols())));
