@@ -21,8 +21,9 @@ struct FiberFamily {
   bool isochoric = false;
 
   double energy(const Mat3& cauchy_green, const Vec3& m) const;
-  /// Adds S and dS/dE (when `tangent` is not null) for the unit reference direction `m`.
-  PointStatus add(const Mat3& cauchy_green, const Vec3& m, Vec6& stress, Mat6* tangent) const;
+  /// Adds S and dS/dE (when `tangent` is not null) for the unit reference direction `m`;
+  /// `c_inv` and `j` (C^-1 and J, computed once per point by the material) serve `isochoric`.
+  PointStatus add(const Mat3& cauchy_green, const Mat3& c_inv, double j, const Vec3& m, Vec6& stress, Mat6* tangent) const;
 };
 
 }  // namespace stentsim::solver

@@ -2,22 +2,30 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace stentsim::solver {
 
 PointStatus Material::elastic(const Mat3& cauchy_green, const Vec3* fiber_dirs, Vec6& stress, Mat6* tangent) const {
   stress.setZero();
   if (tangent) tangent->setZero();
-  if (matrix || decoupled_matrix) {
+  // C^-1 and J once per point, for every summand that needs them.
+  const bool kinematics = matrix || decoupled_matrix ||
+                          std::any_of(fibers.begin(), fibers.end(), [](const FiberFamilySpec& f) { return f.law.isochoric; });
+  Mat3 c_inv = Mat3::Identity();
+  double j = 1.0;
+  if (kinematics) {
     const double j2 = cauchy_green.determinant();
     if (!(j2 > 0.0)) return PointStatus::fail("det C <= 0 (inverted element)");
-    const Mat3 c_inv = cauchy_green.inverse();
-    if (matrix)
-      if (auto s = matrix->add(cauchy_green, c_inv, std::sqrt(j2), stress, tangent); !s.ok) return s;
-    if (decoupled_matrix)
-      if (auto s = decoupled_matrix->add(cauchy_green, c_inv, std::sqrt(j2), stress, tangent); !s.ok) return s;
+    c_inv = cauchy_green.inverse();
+    j = std::sqrt(j2);
   }
+  if (matrix)
+    if (auto s = matrix->add(cauchy_green, c_inv, j, stress, tangent); !s.ok) return s;
+  if (decoupled_matrix)
+    if (auto s = decoupled_matrix->add(cauchy_green, c_inv, j, stress, tangent); !s.ok) return s;
   for (std::size_t f = 0; f < fibers.size(); ++f)
-    if (auto s = fibers[f].law.add(cauchy_green, fiber_dirs[f], stress, tangent); !s.ok) return s;
+    if (auto s = fibers[f].law.add(cauchy_green, c_inv, j, fiber_dirs[f], stress, tangent); !s.ok) return s;
   if (!stress.allFinite()) return PointStatus::fail("stress is not finite");
   return PointStatus::good();
 }

@@ -135,36 +135,24 @@ TEST(SolverMaterials, StressFreeReference) {
   }
 }
 
+// Both matrices at C = I are Hooke's law with the same lambda and mu: the coupled one by
+// lambda = 4 c beta, the decoupled one by lambda = K - 2 mu / 3.
 TEST(SolverMaterials, SmallStrainLimitIsHooke) {
-  // Linearized coupled neo-Hooke at C = I: lambda = 2 c beta * 2 = E nu / ((1+nu)(1-2nu)), mu = E / (2(1+nu)).
-  for (double nu : {0.0, 0.3, 0.45}) {
-    const double young = 2.5;
-    Material m;
-    m.matrix = CoupledNeoHooke::from_young_poisson(young, nu);
-    Vec6 s;
-    Mat6 d;
-    ASSERT_TRUE(m.elastic(Mat3::Identity(), nullptr, s, &d).ok);
-    const double lambda = young * nu / ((1 + nu) * (1 - 2 * nu)), mu = young / (2 * (1 + nu));
-    EXPECT_NEAR(d(0, 0), lambda + 2 * mu, 1e-12);
-    EXPECT_NEAR(d(0, 1), lambda, 1e-12);
-    EXPECT_NEAR(d(3, 3), mu, 1e-12);
-  }
-}
-
-// Decoupled neo-Hooke at C = I: K 1 (x) 1 + 2 mu (II - 1/3 1 (x) 1), so lambda = K - 2 mu / 3.
-TEST(SolverMaterials, DecoupledSmallStrainLimitIsHooke) {
-  for (double nu : {0.0, 0.3, 0.45}) {
-    const double young = 2.5;
-    Material m;
-    m.decoupled_matrix = DecoupledNeoHooke::from_young_poisson(young, nu);
-    Vec6 s;
-    Mat6 d;
-    ASSERT_TRUE(m.elastic(Mat3::Identity(), nullptr, s, &d).ok);
-    EXPECT_LT(s.norm(), 1e-15);
-    const double lambda = young * nu / ((1 + nu) * (1 - 2 * nu)), mu = young / (2 * (1 + nu));
-    EXPECT_NEAR(d(0, 0), lambda + 2 * mu, 1e-12);
-    EXPECT_NEAR(d(0, 1), lambda, 1e-12);
-    EXPECT_NEAR(d(3, 3), mu, 1e-12);
+  for (bool decoupled : {false, true}) {
+    for (double nu : {0.0, 0.3, 0.45}) {
+      const double young = 2.5;
+      Material m;
+      if (decoupled) m.decoupled_matrix = DecoupledNeoHooke::from_young_poisson(young, nu);
+      else m.matrix = CoupledNeoHooke::from_young_poisson(young, nu);
+      Vec6 s;
+      Mat6 d;
+      ASSERT_TRUE(m.elastic(Mat3::Identity(), nullptr, s, &d).ok);
+      EXPECT_LT(s.norm(), 1e-15);
+      const double lambda = young * nu / ((1 + nu) * (1 - 2 * nu)), mu = young / (2 * (1 + nu));
+      EXPECT_NEAR(d(0, 0), lambda + 2 * mu, 1e-12) << "decoupled " << decoupled << " nu " << nu;
+      EXPECT_NEAR(d(0, 1), lambda, 1e-12) << "decoupled " << decoupled << " nu " << nu;
+      EXPECT_NEAR(d(3, 3), mu, 1e-12) << "decoupled " << decoupled << " nu " << nu;
+    }
   }
 }
 
