@@ -94,7 +94,6 @@ void BeamToSurfacePair::refresh_search(const Eigen::VectorXd& u) {
     face_boxes_[f].max().array() += grow;
   }
   ++searches_;
-  pattern_reserved_ = false;
   searched_points_.clear();
   for (std::size_t e = 0; e < gauss_.size(); ++e) {
     const auto x = centerline(u, e);
@@ -166,11 +165,13 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
   GapDerivatives gd;
   NormalFieldDerivatives nd;
   std::vector<PairBlock> blocks;
+  std::vector<int> near;  // the faces this element's points project onto within reach
   int unconverged = 0;
   for (std::size_t e = 0; e < ne; ++e) {
     if (!state.owns(e, ne)) continue;
     const auto x = centerline(state.u, e);
     blocks.clear();
+    near.clear();
     for (int q = 0; q < ng; ++q) {
       const GaussPoint& gp = gauss_[e][static_cast<std::size_t>(q)];
       const std::size_t id = e * static_cast<std::size_t>(ng) + static_cast<std::size_t>(q);
@@ -188,6 +189,7 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
                                          name_, q, e, p.x(), p.y(), p.z(),
                                          where == Reach::deep ? fmt::format("lies more than the search reach inside '{}'", surface_->name())
                                                               : fmt::format("projects onto no face of '{}'", surface_->name())));
+      if (face >= 0) near.push_back(face);
       const bool active = face >= 0 && pr.distance - settings_.radius < settings_.law.active_limit();
       // The active set of Newton iterates (tangent assemblies), not of line-search trials.
       if (tangent) {
@@ -309,25 +311,33 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       const std::vector<GlobalDof> dofs = dofs_of(patch);
       out.add(dofs, r, K);
     }
-    if (tangent && !pattern_reserved_) {
-      // The global pattern only grows: a pair reserved after an earlier search still has its entries.
+    if (tangent) {
+      // Reserve the pattern of the faces a point is near but not yet pressed on, so that its
+      // contact usually starts inside the pattern the solver has analysed. Only these: all the
+      // search's candidate faces (every face within the margin of the element's box) made the
+      // matrix 40 % larger and its LU fill 25 % (free expansion: 1.45 M against 1.04 M entries).
+      // The global pattern only grows, so a pair reserved once keeps its entries.
       std::vector<int>& done = reserved_[e];
-      for (int face : candidates_[e].faces) {
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+      bool added = false;
+      for (int face : near) {
         if (std::binary_search(done.begin(), done.end(), face)) continue;
+        added = true;
         if (std::any_of(blocks.begin(), blocks.end(), [&](const PairBlock& b) { return b.face == face; })) continue;
         patch_of(face, patch);
         const std::vector<GlobalDof> dofs = dofs_of(patch);
         const auto n = static_cast<Eigen::Index>(dofs.size());
         out.add(dofs, Eigen::VectorXd::Zero(n), Eigen::MatrixXd::Zero(n, n));
       }
-      std::vector<int> merged;
-      std::vector<int> now = candidates_[e].faces;
-      std::sort(now.begin(), now.end());
-      std::set_union(done.begin(), done.end(), now.begin(), now.end(), std::back_inserter(merged));
-      done.swap(merged);
+      if (added) {
+        std::vector<int> merged;
+        std::set_union(done.begin(), done.end(), near.begin(), near.end(), std::back_inserter(merged));
+        done.swap(merged);
+      }
     }
   }
-  if (tangent) pattern_reserved_ = true, unconverged_ = unconverged;
+  if (tangent) unconverged_ = unconverged;
 }
 
 std::vector<BeamContactPoint> BeamToSurfacePair::evaluate(const Eigen::VectorXd& u) const {

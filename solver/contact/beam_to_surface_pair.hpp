@@ -17,10 +17,11 @@
 // T = ∂v/∂(DOFs).
 //
 // Search: once per step (begin_step) each beam element collects the faces
-// whose boxes lie within the search margin of its Gauss points (face_search.hpp);
-// those pairs reserve their matrix pattern (zeros while apart), so the pattern
-// grows at most when the search is redone, which happens when a Gauss point
-// or a surface node moved more than half the margin since the search.
+// whose boxes lie within the search margin of its Gauss points (face_search.hpp),
+// and searches again when a Gauss point or a surface node moved more than half
+// the margin since. A pair whose point projects onto a face within reach (the
+// margin) reserves its matrix pattern while still apart (zeros), so contact
+// usually starts inside the analysed pattern; the pattern only grows.
 // Projection failures: a Gauss point that finds no face it projects inside is
 // out of contact — unless it was in contact in the last converged state: then
 // the trial state is a failed iteration (ElementFailure) and the step is cut,
@@ -134,7 +135,6 @@ class BeamToSurfacePair : public Term {
   /// before the next search): a point outside it cannot project onto the face within reach.
   std::vector<Eigen::AlignedBox3d> face_boxes_;
   std::vector<Vec3> searched_points_, searched_nodes_;
-  bool pattern_reserved_ = false;
   std::vector<std::vector<int>> reserved_;  // per element, the faces whose pattern was reserved (sorted)
   ActiveSet active_;  // per Gauss point (element-major)
   long long searches_ = 0;

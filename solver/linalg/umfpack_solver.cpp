@@ -34,6 +34,17 @@ std::string umfpack_status_text(SuiteSparse_long status) {
   }
 }
 
+const char* strategy_name(double s) {
+  return s == UMFPACK_STRATEGY_SYMMETRIC ? "symmetric" : s == UMFPACK_STRATEGY_UNSYMMETRIC ? "unsymmetric" : "other";
+}
+const char* ordering_name(double o) {
+  if (o == UMFPACK_ORDERING_AMD) return "AMD";
+  if (o == UMFPACK_ORDERING_METIS) return "METIS";
+  if (o == UMFPACK_ORDERING_CHOLMOD) return "CHOLMOD";
+  if (o == UMFPACK_ORDERING_NONE) return "none";
+  return "other";
+}
+
 class UmfpackSolver : public LinearSolver {
  public:
   UmfpackSolver() {
@@ -65,9 +76,11 @@ class UmfpackSolver : public LinearSolver {
       }
       row_ptr_ = a.row_ptr;
       cols_ = a.cols;
-      log::debug("UMFPACK analysis: n = {}, nnz(A) = {}, estimated nnz(L + U) = {:.0f}, {:.0f} MB", n, a.nonzeros(),
-                 info_[UMFPACK_LNZ_ESTIMATE] + info_[UMFPACK_UNZ_ESTIMATE],
-                 info_[UMFPACK_NUMERIC_SIZE_ESTIMATE] * info_[UMFPACK_SIZE_OF_UNIT] / 1e6);
+      log::debug("UMFPACK analysis: n = {}, nnz(A) = {}, estimated nnz(L + U) = {:.0f}, {:.0f} MB ({} strategy, {} ordering), "
+                 "{:.2f} s", n, a.nonzeros(), info_[UMFPACK_LNZ_ESTIMATE] + info_[UMFPACK_UNZ_ESTIMATE],
+                 info_[UMFPACK_NUMERIC_SIZE_ESTIMATE] * info_[UMFPACK_SIZE_OF_UNIT] / 1e6,
+                 strategy_name(info_[UMFPACK_STRATEGY_USED]), ordering_name(info_[UMFPACK_ORDERING_USED]),
+                 std::chrono::duration<double>(Clock::now() - t0).count());
     }
     if (numeric_) umfpack_dl_free_numeric(&numeric_);
     const SuiteSparse_long st = umfpack_dl_numeric(ap, ai, a.values.data(), symbolic_, &numeric_, control_, info_);
