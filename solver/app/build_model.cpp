@@ -226,4 +226,11 @@ Eigen::MatrixXd amg_near_null_space(const SceneDesc& scene, const BuiltModel& b)
   return modes;
 }
 
+Eigen::MatrixXd amg_node_coordinates(const BuiltModel& b) {
+  Eigen::MatrixXd xyz = Eigen::MatrixXd::Zero(b.model.dofs.size() / 3, 3);
+  for (const auto& [name, body] : b.bodies)
+    for (std::size_t i = 0; i < body->num_nodes(); ++i) xyz.row(body->dof(i, 0) / 3) = body->mesh().points[i].transpose();
+  return xyz;
+}
+
 }  // namespace stentsim::solver

@@ -49,5 +49,8 @@ std::unique_ptr<BuiltModel> build_model(const SceneDesc& scene);
 /// The 6 rigid-body modes of the solid nodes for SA-AMG; InputError naming the
 /// scene's solver.linear.type when the model has DOFs they cannot describe.
 Eigen::MatrixXd amg_near_null_space(const SceneDesc& scene, const BuiltModel& b);
+/// The solid nodes' reference coordinates, row d/3 for the node whose first DOF is d
+/// (call after amg_near_null_space, which checks that every unknown is a solid displacement).
+Eigen::MatrixXd amg_node_coordinates(const BuiltModel& b);
 
 }  // namespace stentsim::solver

@@ -42,7 +42,10 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   for (const auto& o : built->observers) observers.emplace_back(o->checkpoint_name() + "/", o.get());
 
   auto linear = make_linear_solver(linear_settings);
-  if (linear_settings.type == LinearSolverType::gmres_amg) linear->set_near_null_space(amg_near_null_space(scene, *built));
+  if (linear_settings.type == LinearSolverType::gmres_amg) {
+    linear->set_near_null_space(amg_near_null_space(scene, *built));
+    linear->set_node_coordinates(amg_node_coordinates(*built));
+  }
   // Ranks: after the linear solver exists (Trilinos initialises MPI when the
   // CLI has not). Every rank holds u; elements are split; rank 0 writes.
   model.rank = parallel::rank();

@@ -325,6 +325,7 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   scene.newton.increment_tolerance = nw.number("increment_tolerance", 1e-8, Range::positive());
   scene.newton.line_search_steps = nw.integer("line_search_steps", 6, Range::between(0, 30));
   scene.newton.predictor = nw.choice("predictor", {"extrapolate", "none"}, "extrapolate") == "extrapolate";
+  scene.newton.inexact = nw.choice("forcing", {"eisenstat_walker", "none"}, "eisenstat_walker") == "eisenstat_walker";
   nw.finish();
   ConfigMap li = s.map("linear");
   scene.linear.type = read_linear_solver(li, "type", LinearSolverType::direct);

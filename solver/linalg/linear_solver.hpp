@@ -64,6 +64,13 @@ class LinearSolver {
   /// describe, e.g. a beam rotation or a multiplier): SA-AMG with a fixed block
   /// of `amg_equations_per_node` would otherwise build a wrong coarse space.
   virtual void set_near_null_space(const Eigen::MatrixXd& modes) {}
+  /// AMG: the mesh nodes' coordinates (row i: the node of unknowns eq*i .. eq*i+eq-1),
+  /// for MueLu's geometric options (a distance-Laplacian drop); ignored by others.
+  virtual void set_node_coordinates(const Eigen::MatrixXd& xyz) {}
+  /// Krylov solvers: the relative residual at which the following solves stop
+  /// (an inexact Newton's forcing term), never tighter than the settings'
+  /// tolerance; 0 restores that. Returns false for direct solvers, which ignore it.
+  virtual bool set_relative_tolerance(double tolerance) { return false; }
   virtual std::string describe() const = 0;
 };
 

@@ -64,6 +64,12 @@ class TrilinosSolver : public LinearSolver {
   }
 
   void set_near_null_space(const Eigen::MatrixXd& modes) override { modes_ = modes; }
+  void set_node_coordinates(const Eigen::MatrixXd& xyz) override { coordinates_ = xyz; }
+
+  bool set_relative_tolerance(double tolerance) override {
+    requested_tolerance_ = tolerance;
+    return settings_.type != LinearSolverType::direct;
+  }
 
   std::string describe() const override {
     if (settings_.type == LinearSolverType::direct)
@@ -90,13 +96,21 @@ class TrilinosSolver : public LinearSolver {
     // the Tpetra matrix is refilled in place and only compute() is redone.
     // (Not on several ranks: AdditiveSchwarz imports the overlap rows in
     // initialize() only, so a refilled matrix would leave them stale.)
-    const bool keep_ilu = settings_.type == LinearSolverType::gmres_ilu && comm_->getSize() == 1;
-    const bool reuse_ilu = keep_ilu && ilu_prec_ && a.row_ptr == ilu_row_ptr_ && a.cols == ilu_cols_;
+    //
+    // AMG on one rank likewise: while the pattern stays, the hierarchy's
+    // prolongators (aggregates and their smoothing, ~2/3 of its set-up) are kept
+    // and only the coarse operators RAP and the smoothers are recomputed from the
+    // new values (MueLu "reuse: type" RP). A Newton iteration's matrix differs
+    // from the last one by the change of the tangent, which moves the near-null
+    // space the aggregates were built for not at all.
+    const bool keep = (settings_.type == LinearSolverType::gmres_ilu || settings_.type == LinearSolverType::gmres_amg) &&
+                      comm_->getSize() == 1;
+    const bool reuse = keep && kept_prec_ && a.row_ptr == kept_row_ptr_ && a.cols == kept_cols_;
     RCP<const Map> map;
     RCP<Matrix> mat;
-    if (reuse_ilu) {
-      map = ilu_matrix_->getRowMap();
-      mat = ilu_matrix_;
+    if (reuse) {
+      map = kept_matrix_->getRowMap();
+      mat = kept_matrix_;
       refill(*mat, a);
     } else {
       map = rcp(new Map(n, 0, comm_));
@@ -117,16 +131,22 @@ class TrilinosSolver : public LinearSolver {
     }
     {
       RCP<OP> prec;
-      if (reuse_ilu) {
-        ilu_prec_->compute();
-        prec = ilu_prec_;
+      if (reuse) {
+        if (auto ilu = Teuchos::rcp_dynamic_cast<Ifpack2::Preconditioner<SC, LO, GO, NO>>(kept_prec_)) {
+          ilu->compute();
+        } else {
+          auto amg = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(kept_prec_, true);
+          MueLu::ReuseTpetraPreconditioner(mat, *amg);
+          stats.amg_levels = amg->GetHierarchy()->GetNumLevels();
+        }
+        prec = kept_prec_;
       } else {
-        prec = make_preconditioner(mat, map, stats);
-        if (keep_ilu) {
-          ilu_prec_ = Teuchos::rcp_dynamic_cast<Ifpack2::Preconditioner<SC, LO, GO, NO>>(prec, true);
-          ilu_matrix_ = mat;
-          ilu_row_ptr_ = a.row_ptr;
-          ilu_cols_ = a.cols;
+        prec = make_preconditioner(mat, map, stats, keep);
+        if (keep) {
+          kept_prec_ = prec;
+          kept_matrix_ = mat;
+          kept_row_ptr_ = a.row_ptr;
+          kept_cols_ = a.cols;
         }
       }
       const auto t1 = Clock::now();
@@ -137,7 +157,7 @@ class TrilinosSolver : public LinearSolver {
       params->set("Num Blocks", settings_.krylov_size);
       params->set("Maximum Iterations", settings_.max_iterations);
       params->set("Maximum Restarts", std::max(1, settings_.max_iterations / std::max(1, settings_.krylov_size)));
-      params->set("Convergence Tolerance", settings_.tolerance);
+      params->set("Convergence Tolerance", std::max(settings_.tolerance, requested_tolerance_));
       params->set("Verbosity", settings_.verbosity > 0 ? Belos::Errors + Belos::Warnings + Belos::FinalSummary
                                                         : Belos::Errors);
       Belos::BlockGmresSolMgr<SC, MV, OP> gmres(problem, params);
@@ -270,7 +290,8 @@ class TrilinosSolver : public LinearSolver {
                            "the rigid-body modes do not describe, e.g. a beam rotation or a multiplier: use direct or gmres_ilu)");
   }
 
-  RCP<OP> make_preconditioner(const RCP<Matrix>& mat, const RCP<const Map>& map, LinearSolveStats& stats) const {
+  // `reusable`: AMG keeps its prolongators for ReuseTpetraPreconditioner.
+  RCP<OP> make_preconditioner(const RCP<Matrix>& mat, const RCP<const Map>& map, LinearSolveStats& stats, bool reusable) const {
     if (settings_.type == LinearSolverType::gmres_ilu) {
       using RowMatrix = Tpetra::RowMatrix<SC, LO, GO, NO>;
       Teuchos::ParameterList p;
@@ -297,6 +318,7 @@ class TrilinosSolver : public LinearSolver {
       p.set("multigrid algorithm", std::string("sa"));
       p.set("number of equations", settings_.amg_equations_per_node);
       p.set("coarse: max size", 1000);
+      if (reusable) p.set("reuse: type", std::string("RP"));
       // Symmetric Gauss-Seidel smoothing, for the scalar Laplace problems of the
       // fibers and for elasticity alike. MueLu's default Chebyshev smoother
       // relies on a power-iteration estimate of the largest eigenvalue of
@@ -330,6 +352,18 @@ class TrilinosSolver : public LinearSolver {
             ns->replaceLocalValue(i, static_cast<std::size_t>(c), modes_(map->getGlobalElement(i), c));
         p.sublist("user data").set("Nullspace", ns);
       }
+      const int eq = settings_.amg_equations_per_node;
+      const std::size_t local = map->getNodeNumElements();
+      const bool blocked = local % static_cast<std::size_t>(eq) == 0 && (local == 0 || map->getGlobalElement(0) % eq == 0);
+      if (coordinates_.rows() * eq == static_cast<Eigen::Index>(map->getGlobalNumElements()) && blocked) {
+        // The node map: this rank's rows in blocks of eq (MueLu aggregates such blocks).
+        RCP<const Map> nodes = rcp(new Map(static_cast<GO>(coordinates_.rows()), local / static_cast<std::size_t>(eq), 0, comm_));
+        RCP<MV> xyz = rcp(new MV(nodes, static_cast<std::size_t>(coordinates_.cols())));
+        for (LO i = 0; i < static_cast<LO>(nodes->getNodeNumElements()); ++i)
+          for (Eigen::Index c = 0; c < coordinates_.cols(); ++c)
+            xyz->replaceLocalValue(i, static_cast<std::size_t>(c), coordinates_(nodes->getGlobalElement(i), c));
+        p.sublist("user data").set("Coordinates", xyz);
+      }
       RCP<OP> op = mat;
       RCP<MueLu::TpetraOperator<SC, LO, GO, NO>> prec = MueLu::CreateTpetraPreconditioner(op, p);
       stats.amg_levels = prec->GetHierarchy()->GetNumLevels();
@@ -342,11 +376,14 @@ class TrilinosSolver : public LinearSolver {
   RCP<const Teuchos::Comm<int>> comm_;
   // "direct": UMFPACK on rank 0 (keeps its symbolic analysis while the pattern stays).
   std::unique_ptr<LinearSolver> direct_ = make_umfpack_solver();
-  // gmres_ilu on one rank: the matrix and RILUK kept while the pattern stays.
-  RCP<Matrix> ilu_matrix_;
-  RCP<Ifpack2::Preconditioner<SC, LO, GO, NO>> ilu_prec_;
-  std::vector<std::int64_t> ilu_row_ptr_, ilu_cols_;
+  // gmres_ilu and gmres_amg on one rank: the matrix and the preconditioner (RILUK, or
+  // the MueLu hierarchy with its prolongators) kept while the pattern stays.
+  RCP<Matrix> kept_matrix_;
+  RCP<OP> kept_prec_;
+  std::vector<std::int64_t> kept_row_ptr_, kept_cols_;
   Eigen::MatrixXd modes_;
+  Eigen::MatrixXd coordinates_;       // set_node_coordinates
+  double requested_tolerance_ = 0.0;  // set_relative_tolerance
 };
 
 }  // namespace

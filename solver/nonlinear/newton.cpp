@@ -103,8 +103,26 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
 
   double prev_du_norm = 0.0;    // the last iteration's correction
   bool prev_full_step = false;  // ... and whether the line search took all of it
+  double eta = 0.0, prev_r_norm = 0.0;  // the forcing term of the last solve and the residual it started from
   for (int it = 1; it <= settings.max_iterations; ++it) {
     res.iterations = it;
+    if (settings.inexact) {
+      // Eisenstat-Walker choice 2 with its safeguard (header), at most eta_max; then never
+      // tighter than half of what the residual test, |R| <= tau, still asks (up to 0.5):
+      // once |R| is within tau the solve only serves the increment test.
+      constexpr double eta_max = 1e-2, gamma = 0.9;
+      double e = eta_max;
+      if (it > 1 && prev_r_norm > 0.0) {
+        e = gamma * std::pow(r_norm / prev_r_norm, 2);
+        if (gamma * eta * eta > 0.1) e = std::max(e, gamma * eta * eta);
+        e = std::min(e, eta_max);
+      }
+      const double tau = settings.residual_tolerance * scale + settings.residual_absolute;
+      if (r_norm > 0.0) e = std::max(e, std::min(0.5, 0.5 * tau / r_norm));
+      eta = e;
+      if (!linear.set_relative_tolerance(eta)) eta = 0.0;
+      prev_r_norm = r_norm;
+    }
     // Linear solve in local (frame) coordinates, then back to global.
     Eigen::VectorXd du;
     const auto t0 = Clock::now();
@@ -186,9 +204,11 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     const bool r_ok = r_norm <= settings.residual_tolerance * scale + settings.residual_absolute;
     const bool du_ok = du_error <= settings.increment_tolerance * std::max(u.norm(), 1e-12) ||
                        du_norm <= settings.increment_absolute || r_norm == 0.0;
-    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}", it, r_norm,
-               scale, du_norm, best_alpha, ls.iterations,
-               ls.amg_levels > 0 ? fmt::format(" (AMG levels {})", ls.amg_levels) : std::string());
+    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}{}, set-up {:.2f} s, "
+               "solve {:.2f} s", it, r_norm, scale, du_norm, best_alpha, ls.iterations,
+               eta > 0.0 ? fmt::format(" to {:.1e}", eta) : std::string(),
+               ls.amg_levels > 0 ? fmt::format(" (AMG levels {})", ls.amg_levels) : std::string(), ls.setup_seconds,
+               ls.solve_seconds);
     // Round-off floor: an increment at machine precision cannot improve the state
     // further (tiny loads on stiff models leave |R| just above an absolute tolerance).
     // Only after a linear solve that converged: a failed Krylov solve can return

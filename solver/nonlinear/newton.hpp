@@ -13,6 +13,14 @@
 // extra assemblies, never the step. The force scale of the convergence test is
 // the residual at the converged state whether or not the guess is kept: a good
 // guess must not tighten it.
+//
+// Inexact Newton: a Krylov solve only needs to reduce the linear residual as
+// far as the nonlinear one will follow. Iteration k stops its solve at
+// |b - A du| <= eta_k |b| with Eisenstat & Walker's choice 2 (SIAM J. Sci.
+// Comput. 17, 1996, Eq. 2.6 and its safeguard), eta_k = 0.9 (|R_k|/|R_k-1|)^2,
+// at most 1e-2, and never below half of what the residual test still asks
+// (Kelley 1995, Sec. 6.3): far from the solution a few Krylov iterations, near
+// it as accurate as quadratic convergence needs, and no oversolving at the end.
 #include <Eigen/Core>
 
 #include <string>
@@ -31,6 +39,9 @@ struct NewtonSettings {
   double increment_absolute = 0.0;    // |du| at or below this also satisfies the increment test (0: off)
   int line_search_steps = 6;          // halvings
   bool predictor = true;              // the stepper starts each step from the last step's increment, extrapolated
+  /// Krylov solvers stop at the Eisenstat-Walker forcing term instead of their fixed tolerance
+  /// (which stays the tightest they are asked for); direct solvers ignore it.
+  bool inexact = true;
 };
 
 struct NewtonResult {
