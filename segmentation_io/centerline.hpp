@@ -105,5 +105,9 @@ CenterlineAccuracy compare_with_true_centerline(const MeshData& computed, const 
 /// centerline_distance_max, inscribed_radius_error_max, stenosis_site_error).
 void run_centerline_stage(const CenterlineOptions& options, const std::filesystem::path& lumen_vtp,
                           const std::filesystem::path& out_centerline_vtp, Summary& summary);
+/// The same on a lumen already read (`source` names it in errors): the stand-alone
+/// tool passes a user's file through the case path's reader and surface checks first.
+void run_centerline_stage(const CenterlineOptions& options, const MeshData& lumen, const std::string& source,
+                          const std::filesystem::path& out_centerline_vtp, Summary& summary);
 
 }  // namespace stentsim::segmentation

@@ -30,12 +30,16 @@ CenterlineOptions parse_centerline_options(ConfigMap& section) {
 
 void run_centerline_stage(const CenterlineOptions& options, const std::filesystem::path& lumen_vtp,
                           const std::filesystem::path& out_centerline_vtp, Summary& summary) {
-  MeshData lumen = read_vtp(lumen_vtp.string());
+  run_centerline_stage(options, read_vtp(lumen_vtp.string()), lumen_vtp.string(), out_centerline_vtp, summary);
+}
+
+void run_centerline_stage(const CenterlineOptions& options, const MeshData& lumen, const std::string& source,
+                          const std::filesystem::path& out_centerline_vtp, Summary& summary) {
   CenterlineResult r;
   try {
     r = compute_centerline(lumen, options);
   } catch (const InputError& e) {
-    throw InputError(fmt::format("{}: {}", lumen_vtp.string(), e.what()));
+    throw InputError(fmt::format("{}: {}", source, e.what()));
   }
   write_vtp(out_centerline_vtp.string(), r.centerline);
   summary.set("centerline_length", r.length, "mm");

@@ -117,6 +117,9 @@ TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& o, const st
       }
       keep.push_back(t);
     }
+    if (keep.empty())
+      fail(fmt::format("all {} triangles are degenerate (zero area: repeated or collinear corners) or duplicates; nothing "
+                       "of a surface is left — re-export it from the segmentation tool", s.triangles.size()));
     s.triangles = std::move(keep);
     if (rep.degenerate_triangles)
       repairable(fmt::format("{} degenerate (zero-area) triangles removed, the first at {}", rep.degenerate_triangles,

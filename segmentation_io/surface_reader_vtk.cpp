@@ -14,8 +14,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <optional>
 
 #include "common/error.hpp"
+#include "segmentation_io/stl_binary.hpp"
 #include "segmentation_io/surface_input.hpp"
 
 namespace stentsim::segmentation {
@@ -28,8 +30,38 @@ double unit_length_in_mm(const std::string& u) {
   throw InputError(fmt::format("unknown length unit '{}'; expected mm, cm, m or um", u));
 }
 
+namespace {
+
+TriSurface finite_checked(TriSurface s, const std::filesystem::path& file) {
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (!s.points[i].allFinite())
+      throw InputError(fmt::format("{}: point {} has a coordinate that is not a finite number", file.string(), i + 1));
+  return s;
+}
+
+// Every cell's point ids inside the point list, before a filter dereferences them
+// (VTK's readers pass an out-of-range index through; the triangle filter then reads
+// outside the points).
+void check_point_indices(vtkPolyData* pd, const std::filesystem::path& file) {
+  const vtkIdType n = pd->GetNumberOfPoints();
+  for (vtkCellArray* cells : {pd->GetVerts(), pd->GetLines(), pd->GetPolys(), pd->GetStrips()}) {
+    if (!cells) continue;
+    vtkIdType count = 0, cell = 0;
+    const vtkIdType* ids = nullptr;
+    for (cells->InitTraversal(); cells->GetNextCell(count, ids); ++cell)
+      for (vtkIdType k = 0; k < count; ++k)
+        if (ids[k] < 0 || ids[k] >= n)
+          throw InputError(fmt::format("{}: cell {} refers to point {}, but the file has {} points (indices 0 to {})",
+                                       file.string(), cell + 1, ids[k], n, n - 1));
+  }
+}
+
+}  // namespace
+
 TriSurface read_surface_file(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: surface file not found", file.string()));
+  if (!std::filesystem::is_regular_file(file))
+    throw InputError(fmt::format("{}: not a regular file (a folder, device or pipe); give the surface file itself", file.string()));
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   vtkSmartPointer<vtkAlgorithm> reader;
@@ -47,7 +79,8 @@ TriSurface read_surface_file(const std::filesystem::path& file) {
                                    file.string()));
     reader = r;
   } else if (ext == ".stl") {
-    auto r = vtkSmartPointer<vtkSTLReader>::New();
+    if (std::optional<TriSurface> binary = read_binary_stl(file)) return finite_checked(std::move(*binary), file);
+    auto r = vtkSmartPointer<vtkSTLReader>::New();  // ASCII
     r->SetFileName(file.c_str());
     r->MergingOn();  // STL repeats each vertex per facet
     reader = r;
@@ -58,8 +91,12 @@ TriSurface read_surface_file(const std::filesystem::path& file) {
   } else {
     throw InputError(fmt::format("{}: unknown surface format '{}'; expected .vtp, .vtk, .stl or .obj", file.string(), ext));
   }
+  reader->Update();
+  vtkPolyData* raw = vtkPolyData::SafeDownCast(reader->GetOutputDataObject(0));
+  if (!raw) throw InputError(fmt::format("{}: no surface could be read (damaged {} file?)", file.string(), ext));
+  check_point_indices(raw, file);
   vtkNew<vtkTriangleFilter> tri;
-  tri->SetInputConnection(reader->GetOutputPort());
+  tri->SetInputData(raw);
   tri->PassLinesOff();
   tri->PassVertsOff();
   tri->Update();
@@ -76,9 +113,7 @@ TriSurface read_surface_file(const std::filesystem::path& file) {
     if (ids->GetNumberOfIds() != 3) continue;
     s.triangles.push_back({int(ids->GetId(0)), int(ids->GetId(1)), int(ids->GetId(2))});
   }
-  for (const auto& p : s.points)
-    if (!p.allFinite()) throw InputError(fmt::format("{}: a point coordinate is not a finite number", file.string()));
-  return s;
+  return finite_checked(std::move(s), file);
 }
 
 }  // namespace stentsim::segmentation

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "common/error.hpp"
 #include "segmentation_io/centerline.hpp"
@@ -127,6 +128,74 @@ TEST(SurfaceReaders, ClearErrors) {
   fs::remove_all(d);
 }
 
+// Binary STL by the size rule (84 + 50 n bytes), not by a "solid" prefix; a file
+// cut short is an error, extra bytes a warning; a huge count in the header is
+// checked against the size before anything is allocated; NaN is named.
+TEST(SurfaceReaders, BinaryStlBySizeRule) {
+  const TriSurface ref = small_tube();
+  const fs::path d = temp_dir("stl_size_rule");
+  write_stl_binary(d / "b.stl", ref);
+  std::string bytes;
+  {
+    std::ifstream in(d / "b.stl", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto write = [&](const char* name, const std::string& b) {
+    std::ofstream(d / name, std::ios::binary) << b;
+    return d / name;
+  };
+  // A binary header that starts with "solid" (as many exporters write it).
+  std::string solid = bytes;
+  std::memcpy(solid.data(), "solid exported by a CAD tool", 28);
+  const TriSurface s = read_surface_file(write("solid_header.stl", solid));
+  EXPECT_EQ(s.num_triangles(), ref.num_triangles());
+  EXPECT_EQ(s.points.size(), ref.points.size());
+  // Cut short by 20 bytes: an error naming the count and the sizes.
+  const std::string cut = error_of([&] { read_surface_file(write("cut.stl", bytes.substr(0, bytes.size() - 20))); });
+  EXPECT_CONTAINS(cut, "cut.stl");
+  EXPECT_CONTAINS(cut, "cut short");
+  EXPECT_CONTAINS(cut, std::to_string(ref.num_triangles()) + " triangles");
+  // Trailing bytes: read (with a warning), the same surface.
+  EXPECT_EQ(read_surface_file(write("longer.stl", bytes + std::string(10, '\0'))).num_triangles(), ref.num_triangles());
+  // A header claiming 2^31 triangles in a small file: the size rule, no allocation.
+  std::string huge = bytes;
+  const std::uint32_t n = 1u << 31;
+  std::memcpy(huge.data() + 80, &n, 4);
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(write("huge.stl", huge)); }), "2147483648 triangles");
+  // A NaN coordinate, named by triangle and vertex.
+  std::string nan = bytes;
+  const float q = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(nan.data() + 84 + 50 * 3 + 12 + 12 + 4, &q, 4);  // triangle 4, vertex 2, y
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(write("nan.stl", nan)); }), "vertex 2 of triangle 4");
+  // Neither kind: a few bytes that are no text.
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(write("tiny.stl", std::string("\x01\x02\x03", 3))); }),
+                  "neither an ASCII STL");
+  fs::remove_all(d);
+}
+
+// A cell that refers past the point list, in every VTK-read format, and a folder
+// given as the surface: clear errors, never a crash in a VTK filter.
+TEST(SurfaceReaders, OutOfRangeIndicesAndFoldersAreErrors) {
+  const fs::path d = temp_dir("reader_indices");
+  std::ofstream(d / "bad.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 99\n";
+  std::ofstream(d / "bad.vtk") << "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 double\n"
+                                  "0 0 0\n1 0 0\n0 1 0\nPOLYGONS 2 8\n3 0 1 2\n3 0 1 7\n";
+  std::ofstream(d / "bad.vtp") << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\">\n<PolyData>\n"
+                                  "<Piece NumberOfPoints=\"3\" NumberOfPolys=\"1\">\n<Points><DataArray type=\"Float64\" "
+                                  "NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0</DataArray></Points>\n"
+                                  "<Polys><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 12345"
+                                  "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">3</DataArray>"
+                                  "</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  for (const char* f : {"bad.obj", "bad.vtk", "bad.vtp"}) {
+    const std::string e = error_of([&] { read_surface_file(d / f); });
+    EXPECT_CONTAINS(e, f);
+    EXPECT_CONTAINS(e, "3 points");
+  }
+  fs::create_directories(d / "folder.stl");
+  EXPECT_CONTAINS(error_of([&] { read_surface_file(d / "folder.stl"); }), "not a regular file");
+  fs::remove_all(d);
+}
+
 TEST(SurfaceChecks, UnitsThatSayMetresAreReported) {
   TriSurface t = small_tube();
   for (auto& p : t.points) p *= 1e-3;  // the same tube written in metres
@@ -166,6 +235,13 @@ TEST(SurfaceChecks, DegenerateAndDuplicateTrianglesAreRemoved) {
   SurfaceCheckOptions strict;
   strict.repair = false;
   EXPECT_CONTAINS(error_of([&] { check_and_repair(t, strict, "lumen", rep); }), "degenerate");
+  // Nothing but degenerate triangles (collinear corners over 10 mm): an error, not an empty surface downstream.
+  TriSurface line;
+  for (int i = 0; i < 30; ++i) {
+    line.points.emplace_back(0.3 * i, 0.6 * i, 0.0);
+    if (i >= 2) line.triangles.push_back({i - 2, i - 1, i});
+  }
+  EXPECT_CONTAINS(error_of([&] { check_and_repair(line, {}, "line.stl", rep); }), "all 28 triangles are degenerate");
 }
 
 TEST(SurfaceChecks, NonManifoldEdgeIsAnError) {

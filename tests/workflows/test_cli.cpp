@@ -1,6 +1,9 @@
 // The stentsim binary end to end: init, run, status, a second run that
 // skips everything, and exit codes for bad input.
 #include <gtest/gtest.h>
+
+#include <cstdint>
+#include <limits>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -155,6 +158,34 @@ TEST_F(Cli, EveryPreprocessingStageRunsAsAToolOfItsOwn) {
   EXPECT_NE(r.out.find("bad.yaml:1:9: stent.rngs: unknown key"), std::string::npos) << r.out;
   r = sh("phantom --preset nonesuch --out " + d + "/x");
   EXPECT_EQ(r.code, 2);
+}
+
+// The stand-alone centerline tool reads the lumen by its extension and runs the case
+// path's surface checks: a damaged file is exit 2 naming it, never a centerline of garbage.
+TEST_F(Cli, StandAloneCenterlineChecksItsSurfaceAsTheCasePathDoes) {
+  const std::string d = dir.string();
+  // A binary STL of one triangle with a NaN coordinate (it once reached CGAL through this tool).
+  std::string stl(80, ' ');
+  const std::uint32_t one = 1;
+  stl.append(reinterpret_cast<const char*>(&one), 4);
+  const float record[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, std::numeric_limits<float>::quiet_NaN(), 0};
+  stl.append(reinterpret_cast<const char*>(record), sizeof record);
+  stl.append(2, '\0');
+  stentsim::files::write_atomic(dir / "nan.stl", stl);
+  auto r = sh("centerline --lumen " + d + "/nan.stl --out " + d + "/c1/centerline.vtp");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("nan.stl"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not a finite number"), std::string::npos) << r.out;
+  stentsim::files::write_atomic(dir / "lumen.stl", std::string("solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n"
+                                                               "  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\n"
+                                                               "endsolid x\n"));
+  r = sh("centerline --lumen " + d + "/lumen.stl --out " + d + "/c2/centerline.vtp");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("lumen.stl"), std::string::npos) << r.out;  // read as STL, then refused by the checks
+  EXPECT_EQ(r.out.find("XML"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "c2/centerline.vtp"));
+  r = sh("centerline --lumen " + d + "/lumen.stl --units parsecs --out " + d + "/c3/centerline.vtp");
+  EXPECT_EQ(r.code, 2) << r.out;
 }
 
 TEST_F(Cli, SolveRunsASceneAndRejectsBadOnes) {

@@ -7,6 +7,7 @@
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/phantom.hpp"
 #include "segmentation_io/segmentation_stage.hpp"
+#include "segmentation_io/surface_input.hpp"
 #include "workflows/cli/commands.hpp"
 
 namespace stentsim::cli {
@@ -54,12 +55,13 @@ void register_segmentation(CLI::App& app) {
   });
 
   struct CenterlineArgs {
-    std::string lumen, out, truth;
+    std::string lumen, out, truth, units = "mm";
     double spacing = 0.1;
   };
   auto c = std::make_shared<CenterlineArgs>();
   auto* cl = app.add_subcommand("centerline", "Compute the lumen centerline (VMTK arrays) of a lumen surface");
-  cl->add_option("--lumen", c->lumen, "Lumen surface (VTP with triangles, open ends)")->required();
+  cl->add_option("--lumen", c->lumen, "Lumen surface (.vtp, .vtk, .stl or .obj; two open ends)")->required();
+  cl->add_option("--units", c->units, "Units of the lumen file's coordinates")->check(CLI::IsMember({"mm", "cm", "m", "um"}));
   cl->add_option("--out", c->out, "Output centerline.vtp")->required();
   cl->add_option("--spacing", c->spacing, "Resampling spacing in mm")->check(CLI::PositiveNumber);
   cl->add_option("--true-centerline", c->truth, "A phantom's centerline_true.vtp to report accuracy against");
@@ -68,7 +70,14 @@ void register_segmentation(CLI::App& app) {
     o.spacing = c->spacing;
     if (!c->truth.empty()) o.true_centerline = c->truth;
     Summary summary;
-    segmentation::run_centerline_stage(o, c->lumen, c->out, summary);
+    // The case path's reader (by extension) and surface checks: a damaged or mis-scaled
+    // file is an error here too, not a centerline of garbage.
+    segmentation::SurfaceCheckOptions checks;
+    checks.units = c->units;
+    segmentation::SurfaceReport report;
+    const segmentation::TriSurface lumen = segmentation::load_checked_surface(c->lumen, checks, report);
+    for (std::size_t i = 0; i < report.notes.size(); ++i) summary.note("lumen_repair_" + std::to_string(i + 1), report.notes[i]);
+    segmentation::run_centerline_stage(o, segmentation::mesh_from_surface(lumen), c->lumen, c->out, summary);
     summary.write(std::filesystem::path(c->out).parent_path() / "summary.yaml");
     return 0;
   });
