@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 
 #include "common/error.hpp"
 #include "common/files.hpp"
@@ -38,6 +39,7 @@ void validate(const PatientMeshOptions& o) {
   need(o.end_trim >= 0, "end_trim", "must be non-negative");
   need(o.min_section_gap_ratio >= 0 && o.min_section_gap_ratio < 1, "min_section_gap_ratio", "must be in [0, 1)");
   need(o.algorithm_3d == "delaunay" || o.algorithm_3d == "hxt", "algorithm_3d", "must be delaunay or hxt");
+  need(o.max_elements >= 1, "max_elements", "must be at least 1");
 }
 
 // The per-layer element count is a requirement, the floor min_size_ratio *
@@ -73,6 +75,60 @@ void check_layer_sizing(const WallSections& w, const PatientMeshOptions& o) {
       std::floor(1000 * worst / o.min_elements_per_layer / o.size) / 1000));
 }
 
+
+// Local size as mesh_wall_sections's size callback gives it inside a layer of
+// thickness t: the target, at most t / n, not below the floor.
+static double local_size(double t, const PatientMeshOptions& o) {
+  return std::clamp(std::min(o.size, t / o.min_elements_per_layer), o.min_size_ratio * o.size, o.size);
+}
+
+// Tets per unit volume at edge length h in gmsh's Delaunay meshes of these walls:
+// c / h^3 with c calibrated on the phantoms (a regular tet would give 8.5; gmsh's
+// tets are smaller than the target near the thin layers' faces).
+static constexpr double kTetsPerCubedSize = 11.0;
+
+std::vector<double> estimate_elements(const WallSections& w, const PatientMeshOptions& o) {
+  std::vector<double> count(4, 0.0);
+  const std::size_t ns = w.radius.size(), nk = ns ? w.radius[0].size() : 0;
+  for (std::size_t s = 0; s + 1 < ns; ++s) {
+    const double ds = std::abs(w.abscissa[s + 1] - w.abscissa[s]);
+    for (std::size_t k = 0; k + 1 < nk; ++k) {
+      const std::size_t nr = w.radius[s][k].size();
+      const double dth = 2 * std::numbers::pi / double(nr);
+      for (std::size_t i = 0; i < nr; ++i)
+        for (std::size_t q : {s, s + 1}) {
+          const double lo = w.radius[q][k][i], hi = w.radius[q][k + 1][i];
+          if (!(hi > lo)) continue;
+          const double volume = 0.5 * (hi * hi - lo * lo) * dth * 0.5 * ds;  // half the interval per end section
+          const double h = local_size(hi - lo, o);
+          count[static_cast<std::size_t>(w.layers[k])] += kTetsPerCubedSize * volume / (h * h * h);
+        }
+    }
+  }
+  return count;
+}
+
+void check_element_budget(const WallSections& w, const PatientMeshOptions& o) {
+  double thickest = 0;
+  for (const auto& section : w.radius)
+    for (std::size_t i = 0; !section.empty() && i < section[0].size(); ++i)
+      thickest = std::max(thickest, section.back()[i] - section.front()[i]);
+  if (o.size > 2 * thickest)
+    throw InputError(fmt::format("mesh.size = {:g} mm is more than twice the thickest wall ({:.3g} mm): no layer can be "
+                                 "meshed at that size (the paper meshes at 0.25 mm); set mesh.size to {:.2g} mm or less",
+                                 o.size, thickest, thickest));
+  const std::vector<double> n = estimate_elements(w, o);
+  double total = 0;
+  std::string per_layer;
+  for (int L : w.layers) {
+    total += n[static_cast<std::size_t>(L)];
+    per_layer += fmt::format("{}{} {:.3g}", per_layer.empty() ? "" : ", ", tags::layer_name(L), n[static_cast<std::size_t>(L)]);
+  }
+  if (total > o.max_elements)
+    throw InputError(fmt::format("mesh: about {:.3g} tets are expected at mesh.size = {:g} mm ({}), more than "
+                                 "mesh.max_elements = {:.3g}; raise mesh.size (the count goes with 1/size^3) or "
+                                 "mesh.max_elements", total, o.size, per_layer, o.max_elements));
+}
 
 Vector3d WallSections::point(std::size_t s, std::size_t k, std::size_t i) const {
   const double th = 2 * std::numbers::pi * double(i) / double(radius[s][k].size());
@@ -342,6 +398,10 @@ void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesys
     log::warn("mesh: on {:.1f} % of the rays the wall is thinner than media + adventitia + min_intima; media and adventitia shrink there",
               100 * w.clamped_fraction);
   // gmsh picks the format from the extension: the temporary keeps ".msh".
+  check_element_budget(w, o);
+  const std::vector<double> estimate = estimate_elements(w, o);
+  const double estimated = std::accumulate(estimate.begin(), estimate.end(), 0.0);
+  log::info("mesh: about {:.3g} tets expected; meshing with gmsh", estimated);
   const auto msh_tmp = artery_msh.parent_path() / (".tmp-" + artery_msh.filename().string());
   MeshData m = mesh_wall_sections(w, o, msh_tmp);
   const MeshQuality q = mesh_quality(m);
@@ -351,6 +411,7 @@ void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesys
   summary.set("artery_nodes", double(m.points.size()));
   summary.set("artery_dofs", 3.0 * double(m.points.size()));
   summary.set("artery_elements", double(tets));
+  summary.set("artery_elements_estimate", estimated);
   for (int L : w.layers) summary.set(fmt::format("{}_elements", tags::layer_name(L)), double(q.elements_per_layer[std::size_t(L)]));
   summary.set("min_scaled_jacobian", q.min_scaled_jacobian);
   summary.set("max_aspect_ratio", q.max_aspect_ratio);

@@ -51,6 +51,10 @@ struct PatientMeshOptions {
   /// runs on the same input differed (case2-rca tet10 at 0.25 mm: 118,614 vs
   /// 118,557 tets in one process).
   std::string algorithm_3d = "delaunay";
+  /// The mesh stage refuses, before gmsh runs, a mesh whose estimated tet count
+  /// (estimate_elements) is above this: a size far too small would mesh for hours.
+  /// case2-rca at 0.25 mm is ~1.2e5; 1e6 tet10 is ~4.5 M DOFs, more than a 12 GiB solve holds.
+  double max_elements = 1e6;
 };
 
 /// Radii of the lumen, the layer interfaces and the outer wall along rays of
@@ -88,6 +92,18 @@ double check_wall_sections(const WallSections& w, double min_gap_ratio);
 /// min_size_ratio * size (the two settings conflict; no silent clamp).
 /// Called by mesh_wall_sections before gmsh runs.
 void check_layer_sizing(const WallSections& w, const PatientMeshOptions& o);
+
+/// Estimated tets of mesh_wall_sections's mesh, per layer (index: the Layer tag): each
+/// layer's volume between consecutive sections, ray by ray, over the volume per tet at
+/// the local size gmsh is given there (as mesh_wall_sections sizes it). Within 2x of
+/// the count gmsh makes on the phantoms (test_meshing_patient).
+std::vector<double> estimate_elements(const WallSections& w, const PatientMeshOptions& o);
+
+/// InputError naming mesh.size, mesh.max_elements and the estimate when the estimated
+/// count is above o.max_elements, or when the size is so large that a layer's floor
+/// (min_size_ratio * size) exceeds the whole wall's thickness many times over (gmsh
+/// crashes on such input). Called by run_patient_mesh before gmsh runs.
+void check_element_budget(const WallSections& w, const PatientMeshOptions& o);
 
 struct MeshQuality {
   /// Minimum over the tets of the corner scaled Jacobian of the straight-sided

@@ -51,6 +51,7 @@ MeshSettings parse_mesh(ConfigMap m, meshing::GenericArterySpec& generic) {
   s.max_aspect_ratio = m.number("max_aspect_ratio", s.max_aspect_ratio, Range::between(1, 1e6));
   s.min_section_gap_ratio = m.number("min_section_gap_ratio", s.min_section_gap_ratio, Range::between(0, 0.99));
   s.algorithm_3d = m.choice("algorithm_3d", {"delaunay", "hxt"}, s.algorithm_3d);  // hxt: not reproducible (gmsh 4.8)
+  s.max_elements = m.number("max_elements", s.max_elements, Range{1.0, 1e9});
   if (s.media_ratio + s.adventitia_ratio >= 0.5) m.fail("adventitia_ratio", "media_ratio + adventitia_ratio must be below 0.5");
   if (!s.intima && s.media_ratio == 0 && s.adventitia_ratio == 0) m.fail("intima", "at least one layer is needed");
   if (auto g = m.optional_map("generic")) {
@@ -65,6 +66,13 @@ MeshSettings parse_mesh(ConfigMap m, meshing::GenericArterySpec& generic) {
     generic.elements_adventitia = g->integer("elements_adventitia", generic.elements_adventitia, Range::between(1, 100));
     if (2 * (generic.media_thickness + generic.adventitia_thickness) >= generic.outer_diameter)
       g->fail("", "media_thickness + adventitia_thickness must be less than outer_diameter / 2");
+    const double hexes = double(generic.elements_around) * generic.elements_along *
+                         (generic.elements_media + generic.elements_adventitia);
+    if (hexes > s.max_elements)
+      g->fail("elements_along", fmt::format("{} around x {} along x {} through = {:.3g} hex8, more than mesh.max_elements = "
+                                            "{:.3g}; lower the counts or raise mesh.max_elements", generic.elements_around,
+                                            generic.elements_along, generic.elements_media + generic.elements_adventitia,
+                                            hexes, s.max_elements));
     g->finish();
   }
   m.finish();

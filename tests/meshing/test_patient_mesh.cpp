@@ -2,6 +2,8 @@
 // tags and outward faces, layer volumes vs the analytic ones, quality, errors.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -204,6 +206,12 @@ TEST(PatientMesh, StageWritesVtuAndMshWithTet10) {
   const std::string head = [&] { std::ifstream f(dir / "artery.msh"); std::string a, b; std::getline(f, a); std::getline(f, b); return b; }();
   EXPECT_EQ(head.substr(0, 3), "4.1");
   EXPECT_GT(std::get<double>(s.qois().at("min_scaled_jacobian").value), 0.1);
+  // The estimate made before gmsh runs (mesh.max_elements) is within 2x of the count it makes.
+  const double estimate = std::get<double>(s.qois().at("artery_elements_estimate").value);
+  const double made = std::get<double>(s.qois().at("artery_elements").value);
+  std::printf("tets: %.0f made, %.0f estimated\n", made, estimate);
+  EXPECT_GT(estimate, 0.5 * made);
+  EXPECT_LT(estimate, 2.0 * made);
 }
 
 TEST(PatientMesh, BadInputIsAnInputError) {

@@ -267,6 +267,33 @@ void expect_quality_error_saying_where(const char* name, const meshing::PatientM
   expect_no_outputs(dir);
 }
 
+// A size far too small would mesh for hours, one far too large crashes gmsh: both are
+// refused before gmsh runs, naming the setting and (too small) the estimated count.
+TEST(PatientMeshLayers, ElementBudgetRefusesAbsurdSizesBeforeMeshing) {
+  const auto dir = stage_inputs("stentsim_test_element_budget");
+  auto o = coarse_tet4();
+  Summary s;
+  auto error_at = [&](double size) -> std::string {
+    o.size = size;
+    try {
+      meshing::run_patient_mesh(dir / "lumen.vtp", dir / "wall.vtp", dir / "centerline.vtp", o, dir / "artery.vtu",
+                                dir / "artery.msh", s);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const std::string tiny = error_at(1e-4);
+  EXPECT_NE(tiny.find("tets are expected at mesh.size = 0.0001 mm"), std::string::npos) << tiny;
+  EXPECT_NE(tiny.find("mesh.max_elements"), std::string::npos) << tiny;
+  const std::string huge = error_at(50.0);
+  EXPECT_NE(huge.find("twice the thickest wall"), std::string::npos) << huge;
+  // The bound is the setting: a budget below the default mesh's estimate refuses it too.
+  o.max_elements = 10;
+  EXPECT_NE(error_at(0.5).find("more than mesh.max_elements = 10"), std::string::npos);
+  expect_no_outputs(dir);
+}
+
 TEST(PatientMeshLayers, ScaledJacobianBelowTheBoundIsAnErrorSayingWhere) {
   auto o = coarse_tet4();
   o.size = 0.5;

@@ -70,6 +70,12 @@ TEST(CaseConfig, BadFilesGiveErrorsThatNameFileLineKeyAndExpectation) {
   EXPECT_NE(msg.find("duplicate key 'scene'"), std::string::npos) << msg;
   msg = load_error("scene: generic-artery\nmesh:\n  generic: {outer_diameter: 1 mm}\n");
   EXPECT_NE(msg.find("less than outer_diameter"), std::string::npos) << msg;
+  // A generic artery too large to allocate: refused by mesh.max_elements with its count, not std::bad_alloc.
+  msg = load_error("scene: generic-artery\nmesh:\n  generic: {elements_around: 4096, elements_along: 100000}\n");
+  EXPECT_NE(msg.find("mesh.generic.elements_along"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("1.64e+09 hex8, more than mesh.max_elements = 1e+06"), std::string::npos) << msg;
+  msg = load_error("scene: patient\nmesh:\n  max_elements: 0\n");
+  EXPECT_NE(msg.find("mesh.max_elements"), std::string::npos) << msg;
 }
 
 TEST(CaseConfig, EveryScenesStagesAreDesignStagesInDesignOrder) {

@@ -32,6 +32,8 @@ void register_mesh(CLI::App& app) {
   c->add_option("--min-scaled-jacobian", a->o.min_scaled_jacobian, "Quality bound");
   c->add_option("--min-section-gap-ratio", a->o.min_section_gap_ratio,
                 "Smallest gap between consecutive sections at the outer wall, as a fraction of their spacing");
+  c->add_option("--max-elements", a->o.max_elements, "Refuse a mesh estimated above this many tets (before gmsh runs)")
+      ->check(CLI::Range(1.0, 1e9));
   c->add_option("--algorithm-3d", a->o.algorithm_3d, "gmsh 3D mesher: delaunay (reproducible) or hxt (gmsh 4.8: not reproducible)")
       ->check(CLI::IsMember({"delaunay", "hxt"}));
   on(c, [a] {
