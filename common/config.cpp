@@ -50,13 +50,30 @@ std::string Range::describe() const {
   return "finite";
 }
 
+namespace {
+// Control characters from a file (a pasted escape sequence, a stray NUL) shown as \xNN:
+// raw in a message they would garble the terminal or the cohort summary.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) out += fmt::format("\\x{:02x}", u);
+    else out += c;
+  }
+  return out;
+}
+}  // namespace
+
 ConfigMap ConfigMap::load(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: file not found", file.string()));
+  if (!std::filesystem::is_regular_file(file))
+    throw InputError(fmt::format("{}: not a regular file (a folder?); give the YAML file itself", file.string()));
   YAML::Node root;
   try {
     root = YAML::LoadFile(file.string());
   } catch (const YAML::Exception& e) {
-    throw InputError(fmt::format("{}:{}:{}: YAML syntax error: {}", file.string(), e.mark.line + 1, e.mark.column + 1, e.msg));
+    throw InputError(fmt::format("{}:{}:{}: YAML syntax error: {}", file.string(), e.mark.line + 1, e.mark.column + 1,
+                                 printable(e.msg)));
   }
   if (!root.IsMap()) throw InputError(fmt::format("{}: expected a YAML map at the top level", file.string()));
   reject_duplicate_keys(root, file, "");
@@ -68,7 +85,8 @@ ConfigMap ConfigMap::from_string(const std::string& text, const std::filesystem:
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw InputError(fmt::format("{}:{}:{}: YAML syntax error: {}", file.string(), e.mark.line + 1, e.mark.column + 1, e.msg));
+    throw InputError(fmt::format("{}:{}:{}: YAML syntax error: {}", file.string(), e.mark.line + 1, e.mark.column + 1,
+                                 printable(e.msg)));
   }
   if (!root.IsMap()) throw InputError(fmt::format("{}: expected a YAML map at the top level", file.string()));
   reject_duplicate_keys(root, file, "");
@@ -86,7 +104,8 @@ std::string ConfigMap::where(const YAML::Node& n) const {
 
 void ConfigMap::fail(const std::string& key, const std::string& message) const {
   YAML::Node at = (!key.empty() && node_[key]) ? node_[key] : node_;
-  throw InputError(fmt::format("{}: {}: {}", where(at), key.empty() ? (path_.empty() ? "(top level)" : path_) : key_path(key), message));
+  throw InputError(printable(
+      fmt::format("{}: {}: {}", where(at), key.empty() ? (path_.empty() ? "(top level)" : path_) : key_path(key), message)));
 }
 
 bool ConfigMap::has(const std::string& key) const { return node_[key].IsDefined() && !node_[key].IsNull(); }
@@ -255,7 +274,7 @@ void ConfigMap::finish() const {
     std::string msg = fmt::format("unknown key '{}'", k);
     if (!hint.empty()) msg += fmt::format(" (did you mean '{}'?)", hint);
     msg += fmt::format("; known keys here: {}", fmt::join(known, ", "));
-    throw InputError(fmt::format("{}: {}: {}", where(kv.first), key_path(k), msg));
+    throw InputError(printable(fmt::format("{}: {}: {}", where(kv.first), key_path(k), msg)));
   }
 }
 

@@ -4,7 +4,9 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -137,6 +139,104 @@ std::optional<IndexToWorld> metaimage_index_to_world(const std::filesystem::path
   }
   if (offset) g.origin = Eigen::Vector3d((*offset)[0], (*offset)[1], (*offset)[2]);
   return checked(g, file.string() + ": " + matrix_key);
+}
+
+namespace {
+// The voxel bytes `need` against the data in `file` after `header_end` (data_file empty)
+// or in the detached `data_file` (relative to the header's folder).
+void check_data_size(const std::filesystem::path& file, const char* format, const std::string& fields, double need,
+                     const std::string& data_file, const char* data_key, std::uintmax_t header_end) {
+  std::uintmax_t have = 0;
+  std::string where = file.string();
+  if (data_file.empty()) {
+    have = std::filesystem::file_size(file) - std::min(header_end, std::filesystem::file_size(file));
+  } else {
+    std::filesystem::path data = data_file;
+    if (data.is_relative()) data = file.parent_path() / data;
+    if (!std::filesystem::is_regular_file(data))
+      throw InputError(fmt::format("{}: {} {} is {} (a regular file of voxel data is expected)", file.string(), data_key,
+                                   data_file, std::filesystem::exists(data) ? "not a regular file (a device or a pipe?)" : "missing"));
+    have = std::filesystem::file_size(data);
+    where = data.string();
+  }
+  if (static_cast<double>(have) < need)
+    throw InputError(fmt::format("{}: the {} voxel data is cut short or damaged: {} need {:.0f} bytes, {} has {}", file.string(),
+                                 format, fields, need, where, have));
+}
+}  // namespace
+
+void check_metaimage_data_size(const std::filesystem::path& file) {
+  std::ifstream f(file, std::ios::binary);
+  if (!f) throw InputError(fmt::format("{}: cannot be opened", file.string()));
+  std::vector<double> dims;
+  std::string type, data_file;
+  int channels = 1;
+  bool compressed = false;
+  std::string line;
+  for (int n = 0; std::getline(f, line) && n < 10000; ++n) {
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+    std::istringstream in(value);
+    if (key == "DimSize") {
+      for (double d; in >> d;) dims.push_back(d);
+    } else if (key == "ElementType") {
+      type = value;
+    } else if (key == "ElementNumberOfChannels") {
+      in >> channels;
+    } else if (key == "CompressedData") {
+      compressed = value == "True" || value == "true";
+    } else if (key == "ElementDataFile") {
+      data_file = value;
+      break;  // the last header field
+    }
+  }
+  static const std::map<std::string, double> kBytes = {
+      {"MET_CHAR", 1}, {"MET_UCHAR", 1}, {"MET_SHORT", 2}, {"MET_USHORT", 2}, {"MET_INT", 4},        {"MET_UINT", 4},
+      {"MET_FLOAT", 4}, {"MET_DOUBLE", 8}, {"MET_LONG_LONG", 8}, {"MET_ULONG_LONG", 8}};
+  const auto bytes = kBytes.find(type);
+  if (compressed || dims.empty() || bytes == kBytes.end() || data_file.empty() || channels < 1) return;
+  double need = bytes->second * channels;
+  for (double d : dims) need *= d;
+  if (data_file == "LIST" || data_file.find(' ') != std::string::npos) return;  // a list or pattern of slice files
+  const auto at = f.tellg();
+  if (at < 0) return;
+  check_data_size(file, "MetaImage", "DimSize and " + type, need, data_file == "LOCAL" ? "" : data_file, "ElementDataFile",
+                  static_cast<std::uintmax_t>(at));
+}
+
+void check_nrrd_data_size(const std::filesystem::path& file) {
+  std::ifstream f(file, std::ios::binary);
+  if (!f) throw InputError(fmt::format("{}: cannot be opened", file.string()));
+  std::vector<double> sizes;
+  std::string type, encoding, data_file;
+  std::string line;
+  for (int n = 0; std::getline(f, line) && n < 10000; ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;  // attached data follows
+    if (line[0] == '#') continue;
+    const auto colon = line.find(':');
+    if (colon == std::string::npos || line.compare(colon, 2, ":=") == 0) continue;
+    const std::string key = trim(line.substr(0, colon)), value = trim(line.substr(colon + 1));
+    std::istringstream in(value);
+    if (key == "sizes") for (double d; in >> d;) sizes.push_back(d);
+    else if (key == "type") type = value;
+    else if (key == "encoding") encoding = value;
+    else if (key == "data file" || key == "datafile") data_file = value;
+  }
+  static const std::map<std::string, double> kBytes = {
+      {"uint8", 1},  {"uchar", 1},  {"unsigned char", 1}, {"int8", 1},   {"signed char", 1}, {"char", 1},
+      {"int16", 2},  {"uint16", 2}, {"short", 2},         {"ushort", 2}, {"unsigned short", 2},
+      {"int32", 4},  {"uint32", 4}, {"int", 4},           {"uint", 4},   {"unsigned int", 4}, {"float", 4},
+      {"int64", 8},  {"uint64", 8}, {"longlong", 8},      {"ulonglong", 8}, {"double", 8}};
+  const auto bytes = kBytes.find(type);
+  if (encoding != "raw" || sizes.empty() || bytes == kBytes.end()) return;  // compressed or text: the reader's to check
+  if (data_file == "LIST" || data_file.find(' ') != std::string::npos || data_file.find('%') != std::string::npos) return;
+  const auto at = f.tellg();
+  if (at < 0 && data_file.empty()) return;
+  double need = bytes->second;
+  for (double d : sizes) need *= d;
+  check_data_size(file, "NRRD", "sizes and type " + type, need, data_file, "data file", static_cast<std::uintmax_t>(std::max<std::streamoff>(at, 0)));
 }
 
 }  // namespace stentsim::segmentation

@@ -2,11 +2,13 @@
 // windowed-sinc smoothing); see label_image.hpp.
 #include <fmt/format.h>
 #include <vtkCellArray.h>
+#include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkDiscreteFlyingEdges3D.h>
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
 #include <vtkMetaImageReader.h>
+#include <vtkNew.h>
 #include <vtkNIFTIImageHeader.h>
 #include <vtkNIFTIImageReader.h>
 #include <vtkNrrdReader.h>
@@ -34,6 +36,34 @@ using Eigen::Vector3d;
 
 namespace {
 
+// VTK's image readers report a short read (a file cut short, a damaged gzip stream)
+// through an error event and return the voxels they did not read as zeros: the first
+// such message is kept and turned into an error naming the file.
+class ReadErrors : public vtkCommand {
+ public:
+  static ReadErrors* New() { return new ReadErrors; }
+  void Execute(vtkObject*, unsigned long, void* data) override {
+    if (first.empty() && data) first = static_cast<const char*>(data);
+  }
+  std::string first;
+};
+
+// Reads through `r`; InputError naming the file when VTK reported an error.
+template <class Reader>
+vtkSmartPointer<vtkImageData> read_voxels(Reader* r, const std::string& name, const char* kind) {
+  vtkNew<ReadErrors> errors;
+  r->AddObserver(vtkCommand::ErrorEvent, errors);
+  r->SetFileName(name.c_str());
+  r->Update();
+  if (!errors->first.empty() || r->GetErrorCode() != 0) {
+    std::string what = errors->first;
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    throw InputError(fmt::format("{}: the {} voxel data could not be read ({}): is the file cut short or damaged?", name, kind,
+                                 what.empty() ? "VTK error code " + std::to_string(r->GetErrorCode()) : what));
+  }
+  return r->GetOutput();
+}
+
 bool ends_with(const std::string& s, const std::string& e) {
   return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
 }
@@ -51,24 +81,20 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   if (ends_with(lower, ".nii") || ends_with(lower, ".nii.gz")) {
     auto r = vtkSmartPointer<vtkNIFTIImageReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable NIfTI file", name));
-    r->SetFileName(name.c_str());
-    r->Update();
-    image = r->GetOutput();
+    image = read_voxels(r.Get(), name, "NIfTI");
     if (r->GetSFormMatrix()) to_world = r->GetSFormMatrix();
     else if (r->GetQFormMatrix()) to_world = r->GetQFormMatrix();
   } else if (ends_with(lower, ".nrrd") || ends_with(lower, ".nhdr")) {
     auto r = vtkSmartPointer<vtkNrrdReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable NRRD file", name));
-    r->SetFileName(name.c_str());
-    r->Update();
-    image = r->GetOutput();
+    check_nrrd_data_size(file);  // vtkImageReader reports a short read as a generic warning only
+    image = read_voxels(r.Get(), name, "NRRD");
     header_geometry = nrrd_index_to_world(file);
   } else if (ends_with(lower, ".mha") || ends_with(lower, ".mhd")) {
     auto r = vtkSmartPointer<vtkMetaImageReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable MetaImage file", name));
-    r->SetFileName(name.c_str());
-    r->Update();
-    image = r->GetOutput();
+    check_metaimage_data_size(file);  // MetaIO reports a short read on stderr only
+    image = read_voxels(r.Get(), name, "MetaImage");
     header_geometry = metaimage_index_to_world(file);
   } else {
     throw InputError(fmt::format("{}: unknown label image type (expected .nii, .nii.gz, .nrrd, .nhdr, .mha or .mhd)",
@@ -82,6 +108,11 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   double spacing[3], origin[3];
   image->GetSpacing(spacing);
   image->GetOrigin(origin);
+  for (int a = 0; a < 3 && !header_geometry; ++a)
+    if (!(std::abs(spacing[a]) > 0) || !std::isfinite(spacing[a]))
+      throw InputError(fmt::format("{}: the voxel spacing is ({:g}, {:g}, {:g}) mm: axis {} has {} spacing; the header's "
+                                   "spacing (NIfTI pixdim, NRRD spacings, MetaImage ElementSpacing) must be positive",
+                                   name, spacing[0], spacing[1], spacing[2], a + 1, std::isfinite(spacing[a]) ? "zero" : "no finite"));
   // Everything below works in index space and maps to the world at the end:
   // flying edges (vertices at edge midpoints) and windowed sinc (topological
   // weights) commute with an affine map, so the result equals working in

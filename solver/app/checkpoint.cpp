@@ -1,6 +1,13 @@
 #include "solver/app/checkpoint.hpp"
 
+#include <fmt/format.h>
+
 #include <span>
+
+#include "common/config.hpp"
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "solver/io/scene.hpp"
 
 namespace stentsim::solver {
 
@@ -35,6 +42,41 @@ SolverCheckpoint SolverCheckpoint::get(const HistoryArchive& in, long long dofs)
   }
   if (in.has("solver/last_dt")) c.last_dt = in.get_scalar("solver/last_dt");
   return c;
+}
+
+std::map<std::string, std::string> state_fingerprint(const SceneDesc& scene, double t) {
+  std::map<std::string, std::string> parts;
+  for (const auto& [section, text] : scene.state_sections) parts["section " + section] = files::text_hash(text);
+  for (const auto& f : scene.state_files)
+    parts["file " + f.lexically_relative(std::filesystem::absolute(scene.file).parent_path()).string()] = std::filesystem::exists(f) ? files::content_hash(f) : "missing";
+  for (const auto& [name, curve] : scene.curves) {
+    // The points up to t and the value at t: what the loads were until the checkpoint.
+    std::string text;
+    for (const auto& [ti, vi] : curve.points())
+      if (ti <= t) text += fmt::format("{:.17g} {:.17g}\n", ti, vi);
+    text += fmt::format("at {:.17g}: {:.17g}\n", t, curve(t));
+    parts["load curve " + name] = files::text_hash(text);
+  }
+  return parts;
+}
+
+void put_fingerprint(HistoryArchive& out, const std::map<std::string, std::string>& parts) {
+  for (const auto& [part, hash] : parts) out.put_text("solver/state/" + part, hash);
+}
+
+void check_fingerprint(const HistoryArchive& in, const std::map<std::string, std::string>& parts,
+                       const std::string& checkpoint, const std::string& scene) {
+  std::string differ;
+  for (const auto& [part, hash] : parts) {
+    const std::string key = "solver/state/" + part;
+    if (in.has_text(key) && in.get_text(key) == hash) continue;
+    differ += fmt::format("{}{}{}", differ.empty() ? "" : ", ", part, in.has_text(key) ? "" : " (not in the checkpoint)");
+  }
+  for (const std::string& key : in.text_keys("solver/state/"))
+    if (!parts.count(key.substr(13))) differ += fmt::format("{}{} (not in the scene)", differ.empty() ? "" : ", ", key.substr(13));
+  if (!differ.empty())
+    throw InputError(fmt::format("{}: the checkpoint was written by another scene than {} (what differs: {}); a checkpoint "
+                                 "resumes only the run that wrote it: run without --restart", checkpoint, scene, differ));
 }
 
 }  // namespace stentsim::solver

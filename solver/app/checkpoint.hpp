@@ -5,6 +5,9 @@
 // observers add their parts under their own prefixes.
 #include <Eigen/Core>
 
+#include <map>
+#include <string>
+
 #include "solver/terms/history_archive.hpp"
 
 namespace stentsim::solver {
@@ -26,5 +29,21 @@ struct SolverCheckpoint {
   /// Reads it back; InputError (naming the checkpoint) when a field is missing or u has another size.
   static SolverCheckpoint get(const HistoryArchive& in, long long dofs);
 };
+
+struct SceneDesc;
+
+/// Named hashes of what the state at time t depends on: the scene's bodies, conditions
+/// and contact pairs (their canonical text), the contents of the files the bodies name,
+/// and each load curve up to t. Not the end time, the output, the QoIs, the solver
+/// settings or the rank count: a run may be resumed with more steps, other outputs or
+/// on other ranks, and a curve may be extended beyond t.
+std::map<std::string, std::string> state_fingerprint(const SceneDesc& scene, double t);
+
+/// Records it in the checkpoint ("solver/state/<part>").
+void put_fingerprint(HistoryArchive& out, const std::map<std::string, std::string>& parts);
+/// InputError naming the checkpoint, the scene and every part that differs (or that the
+/// checkpoint lacks) when the checkpoint was written by another scene.
+void check_fingerprint(const HistoryArchive& in, const std::map<std::string, std::string>& parts,
+                       const std::string& checkpoint, const std::string& scene);
 
 }  // namespace stentsim::solver

@@ -74,6 +74,8 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   if (options.restart) {
     const std::filesystem::path from = options.restart->empty() ? checkpoint_file : *options.restart;
     const HistoryArchive ck = HistoryArchive::read(from);
+    // Before the state's size: another scene's checkpoint is named as such.
+    check_fingerprint(ck, state_fingerprint(scene, ck.get_scalar("solver/time")), from.string(), scene.file.string());
     const SolverCheckpoint state = SolverCheckpoint::get(ck, model.dofs.size());
     u = state.u;
     model.load_history(ck);
@@ -120,6 +122,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     if (scene.checkpoint_every > 0 && r.step % scene.checkpoint_every == 0 && writes) {
       HistoryArchive ck;
       SolverCheckpoint{u, r.time, r.next_dt, r.increment, r.dt, counters}.put(ck);
+      put_fingerprint(ck, state_fingerprint(scene, r.time));
       for (const auto& [prefix, o] : observers) o->save(ck, prefix);
       model.save_history(ck);
       writer.save(ck);

@@ -188,6 +188,24 @@ SceneDesc read_scene(const std::string& text, const std::filesystem::path& file)
 }
 
 namespace {
+
+// Every value under a key `file` (a mesh, a beam, a fiber-frame file), resolved as ConfigMap::path does.
+void collect_files(const YAML::Node& n, const std::filesystem::path& dir, std::vector<std::filesystem::path>& out) {
+  if (n.IsMap()) {
+    for (const auto& kv : n) {
+      if (kv.first.Scalar() == "file" && kv.second.IsScalar()) {
+        std::filesystem::path p = kv.second.Scalar();
+        if (p.is_relative()) p = dir / p;
+        out.push_back(std::filesystem::absolute(p).lexically_normal());
+      } else {
+        collect_files(kv.second, dir, out);
+      }
+    }
+  } else if (n.IsSequence()) {
+    for (const auto& e : n) collect_files(e, dir, out);
+  }
+}
+
 SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   SceneDesc scene;
   scene.file = file;
@@ -358,6 +376,10 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   index = 0;
   for (auto& q : root.map_list("qoi")) scene.qois.push_back(read_entry(q, qoi_kinds(), scene.qois, index++, true));
   root.finish();
+  const YAML::Node& top = root.node();
+  for (const char* section : {"bodies", "conditions", "contact"})
+    scene.state_sections[section] = top[section].IsDefined() ? canonical_yaml(top[section]) : "";
+  collect_files(top["bodies"], file.parent_path(), scene.state_files);
   return scene;
 }
 

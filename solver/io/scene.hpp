@@ -65,6 +65,11 @@ struct SceneDesc {
   int checkpoint_every = 0;                 // checkpoint.bin every N steps (0: none); `solve --restart` resumes
   std::vector<std::shared_ptr<const QoiSpec>> qois;
   std::vector<std::shared_ptr<const ContactSpec>> contacts;
+  /// What a checkpoint's state depends on besides the load curves (app/checkpoint.hpp):
+  /// the canonical text of the `bodies`, `conditions` and `contact` sections, and the
+  /// files the bodies name (meshes, beams, fiber frames).
+  std::map<std::string, std::string> state_sections;
+  std::vector<std::filesystem::path> state_files;
 
   const BodyDesc* body(const std::string& name) const;
 };

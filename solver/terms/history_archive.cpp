@@ -28,7 +28,8 @@ struct Reader {
   std::size_t at = 0;
   std::string file;
   void need(std::size_t n) const {
-    if (at + n > data.size()) throw InputError(fmt::format("{}: truncated checkpoint (at byte {})", file, at));
+    // n from the file: compared without forming at + n (a damaged count must not wrap around).
+    if (n > data.size() - at) throw InputError(fmt::format("{}: truncated checkpoint (at byte {})", file, at));
   }
   template <class T>
   T raw() {
@@ -78,6 +79,8 @@ void HistoryArchive::write(const std::filesystem::path& file) const {
     put_raw(out, static_cast<std::uint64_t>(t.size()));
     out += t;
   }
+  // A checksum of everything before it: a damaged file is an error, never a state.
+  out += files::text_hash(out);
   files::write_atomic(file, out);
 }
 
@@ -86,20 +89,26 @@ HistoryArchive HistoryArchive::read(const std::filesystem::path& file) {
   if (!in) throw InputError(fmt::format("{}: cannot open the checkpoint", file.string()));
   std::stringstream ss;
   ss << in.rdbuf();
-  const std::string data = ss.str();
+  std::string data = ss.str();
   Reader r{data, 0, file.string()};
   if (r.bytes(sizeof(kMagic) - 1) != kMagic) throw InputError(fmt::format("{}: not a stentsim checkpoint", file.string()));
   const auto version = r.raw<std::uint32_t>();
   if (version != kFormatVersion)
     throw InputError(fmt::format("{}: checkpoint format version {}, this build reads version {}", file.string(), version,
                                  kFormatVersion));
+  const std::size_t sum_size = files::text_hash("").size();
+  if (data.size() < r.at + sum_size) r.need(data.size() + 1);
+  const std::string sum = data.substr(data.size() - sum_size);
+  data.resize(data.size() - sum_size);
+  if (files::text_hash(data) != sum)
+    throw InputError(fmt::format("{}: the checkpoint is damaged (its checksum does not match its contents)", file.string()));
   HistoryArchive a;
   a.source_ = file.string();
   const auto na = r.raw<std::uint64_t>();
   for (std::uint64_t i = 0; i < na; ++i) {
     const std::string key = r.bytes(r.raw<std::uint32_t>());
     const auto n = r.raw<std::uint64_t>();
-    r.need(n * sizeof(double));
+    if (n > (data.size() - r.at) / sizeof(double)) r.need(data.size() + 1);  // truncated (or a damaged count)
     std::vector<double> v(n);
     std::memcpy(v.data(), data.data() + r.at, n * sizeof(double));
     r.at += n * sizeof(double);

@@ -22,7 +22,7 @@ namespace stentsim::solver {
 
 class HistoryArchive {
  public:
-  static constexpr std::uint32_t kFormatVersion = 1;
+  static constexpr std::uint32_t kFormatVersion = 2;  // 2: a trailing checksum (files::text_hash)
 
   void put(const std::string& key, std::span<const double> values) { arrays_[key].assign(values.begin(), values.end()); }
   void put(const std::string& key, double value) { arrays_[key] = {value}; }
@@ -34,6 +34,14 @@ class HistoryArchive {
   const std::vector<double>& get(const std::string& key, long long expected_size = -1) const;
   double get_scalar(const std::string& key) const { return get(key, 1)[0]; }
   const std::string& get_text(const std::string& key) const;
+  bool has_text(const std::string& key) const { return texts_.count(key) != 0; }
+  /// The text keys that start with `prefix`, sorted.
+  std::vector<std::string> text_keys(const std::string& prefix) const {
+    std::vector<std::string> keys;
+    for (auto it = texts_.lower_bound(prefix); it != texts_.end() && it->first.compare(0, prefix.size(), prefix) == 0; ++it)
+      keys.push_back(it->first);
+    return keys;
+  }
 
   /// Writes atomically (temporary name + rename).
   void write(const std::filesystem::path& file) const;

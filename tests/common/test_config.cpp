@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "common/config.hpp"
 #include "common/error.hpp"
 
@@ -58,6 +60,23 @@ TEST(Config, SyntaxErrorNamesTheFile) {
   EXPECT_NE(msg.find("YAML syntax error"), std::string::npos) << msg;
   msg = error_of([] { ConfigMap::load("/nonexistent/case.yaml"); });
   EXPECT_NE(msg.find("/nonexistent/case.yaml: file not found"), std::string::npos) << msg;
+}
+
+// Control characters from the file never reach the terminal raw; a folder is not a case file.
+TEST(Config, ControlCharactersAreEscapedAndFoldersRefused) {
+  auto top = ConfigMap::from_string("rings: \"4\\e[2J\"\n\"le\\x01ngth\": 1\n", "c.yaml");
+  auto msg = error_of([&] { top.integer("rings"); });
+  EXPECT_NE(msg.find("got '4\\x1b[2J'"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\x1b'), std::string::npos) << msg;
+  top.integer("missing_ok", 1);
+  msg = error_of([&] { top.finish(); });
+  EXPECT_NE(msg.find("unknown key 'le\\x01ngth'"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\x01'), std::string::npos) << msg;
+  const auto dir = std::filesystem::temp_directory_path() / "stentsim_config_folder.yaml";
+  std::filesystem::create_directories(dir);
+  msg = error_of([&] { ConfigMap::load(dir); });
+  EXPECT_NE(msg.find("not a regular file"), std::string::npos) << msg;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Config, DuplicateKeysAreErrors) {

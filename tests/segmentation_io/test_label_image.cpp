@@ -336,3 +336,64 @@ TEST(LabelImage, MetaImageTransformMatrixRotatesAndMirrors) {
   }
   fs::remove_all(dir);
 }
+
+// A label image cut short (a copy that did not finish) is named as such, in each
+// format, instead of surfacing the zeros VTK fills in; a zero spacing is named.
+TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
+  const fs::path dir = fs::temp_directory_path() / "stentsim_label_truncated";
+  fs::create_directories(dir);
+  const double zero[3] = {0, 0, 0};
+  auto im = cylinder(zero);
+  const std::streamsize voxels = std::streamsize(kDim[0]) * kDim[1] * kDim[2];
+  auto error_of = [](const fs::path& f) -> std::string {
+    LabelSurfaceOptions o;
+    o.labels = {1};
+    try {
+      label_image_surface(f, o);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  auto cut = [](const fs::path& f, std::uintmax_t keep) { fs::resize_file(f, keep); };
+  // NIfTI (uncompressed and gzip), written by VTK, then cut in the voxel data.
+  for (const char* name : {"labels.nii", "labels.nii.gz"}) {
+    auto w = vtkSmartPointer<vtkNIFTIImageWriter>::New();
+    w->SetInputData(im);
+    w->SetFileName((dir / name).c_str());
+    w->Write();
+    cut(dir / name, fs::file_size(dir / name) / 2);
+    const std::string e = error_of(dir / name);
+    EXPECT_NE(e.find(name), std::string::npos) << e;
+    EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
+  }
+  // Raw NRRD and MetaImage (.mha, data in the file).
+  {
+    std::ofstream f(dir / "labels.nrrd", std::ios::binary);
+    f << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << kDim[0] << " " << kDim[1] << " " << kDim[2]
+      << "\nspacings: " << kSp[0] << " " << kSp[1] << " " << kSp[2] << "\nencoding: raw\n\n";
+    f.write(static_cast<const char*>(im->GetScalarPointer()), voxels / 2);
+  }
+  std::string e = error_of(dir / "labels.nrrd");
+  EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
+  {
+    auto w = vtkSmartPointer<vtkMetaImageWriter>::New();
+    w->SetInputData(im);
+    w->SetCompression(false);
+    w->SetFileName((dir / "labels.mha").c_str());
+    w->Write();
+  }
+  cut(dir / "labels.mha", fs::file_size(dir / "labels.mha") - std::uintmax_t(voxels / 2));
+  e = error_of(dir / "labels.mha");
+  EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
+  // A zero spacing in the header.
+  {
+    std::ofstream f(dir / "flat.nrrd", std::ios::binary);
+    f << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << kDim[0] << " " << kDim[1] << " " << kDim[2]
+      << "\nspacings: " << kSp[0] << " 0 " << kSp[2] << "\nencoding: raw\n\n";
+    f.write(static_cast<const char*>(im->GetScalarPointer()), voxels);
+  }
+  e = error_of(dir / "flat.nrrd");
+  EXPECT_NE(e.find("axis 2 has zero spacing"), std::string::npos) << e;
+  fs::remove_all(dir);
+}

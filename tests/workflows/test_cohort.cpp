@@ -421,6 +421,9 @@ TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   // One row per case of the cohort (the four not selected have not run), and
   // the expected failure shows as such in `cohort status`.
   EXPECT_EQ(read_csv(dir / "cohort.work/cohort_summary.csv").size(), 6u) << csv;
+  // The message is the stage's error, not the log's last lines with their prefixes.
+  const std::string message = read_csv(dir / "cohort.work/cohort_summary.csv")["severe"]["message"];
+  EXPECT_EQ(message.rfind("stage placement: ", 0), 0u) << message;
   r = sh("cohort status " + f);
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(status_cells(r.out, "severe")["placement"], "failed (expected)") << r.out;

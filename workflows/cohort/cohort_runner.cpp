@@ -90,6 +90,16 @@ std::string tail_lines(const fs::path& file, int n) {
   return out;
 }
 
+// What a failed run's log says went wrong: its last "error: " line (the runner's own,
+// naming the stage and its error), without the prefix; else the log's last lines.
+std::string failure_message(const fs::path& log) {
+  std::ifstream in(log);
+  std::string line, error;
+  while (std::getline(in, line))
+    if (line.rfind("error: ", 0) == 0) error = line.substr(7);
+  return error.empty() ? tail_lines(log, 3) : error;
+}
+
 std::string failed_stage_of(const fs::path& manifest_file) {
   if (!fs::exists(manifest_file)) return "";
   const auto m = pipeline::Manifest::load(manifest_file);
@@ -203,7 +213,7 @@ CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_co
     r.status = k.expect_failure && stage_succeeded(dir / "work" / "manifest.yaml", *k.expect_failure) ? "succeeded unexpectedly" : "done";
   else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
   else r.status = r.exit_code == 130 ? "interrupted" : "failed";
-  if (r.exit_code) r.message = tail_lines(dir / "run.log", 3);
+  if (r.exit_code) r.message = failure_message(dir / "run.log");
   if (r.exit_code > 128 && r.exit_code != 130)  // the worker itself was killed: its log cannot say so
     r.message = fmt::format("stentsim run killed by signal {} ({}){}", r.exit_code - 128, strsignal(r.exit_code - 128),
                             r.message.empty() ? "" : "; log: " + r.message);
@@ -494,7 +504,7 @@ void add_unselected_cases(const CohortConfig& c, CohortReport& r) {
         else {
           o.status = k.expect_failure && *k.expect_failure == o.failed_stage ? "failed as expected" : "failed";
           o.exit_code = -1;  // not known from the manifest
-          o.message = tail_lines(c.work_dir / k.id / "run.log", 3);
+          o.message = failure_message(c.work_dir / k.id / "run.log");
         }
       }
     }
