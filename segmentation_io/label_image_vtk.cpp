@@ -29,6 +29,7 @@
 #include "segmentation_io/branch_extraction.hpp"
 #include "segmentation_io/image_header_geometry.hpp"
 #include "segmentation_io/label_image.hpp"
+#include "segmentation_io/vtk_read_errors.hpp"
 
 namespace stentsim::segmentation {
 
@@ -36,28 +37,15 @@ using Eigen::Vector3d;
 
 namespace {
 
-// VTK's image readers report a short read (a file cut short, a damaged gzip stream)
-// through an error event and return the voxels they did not read as zeros: the first
-// such message is kept and turned into an error naming the file.
-class ReadErrors : public vtkCommand {
- public:
-  static ReadErrors* New() { return new ReadErrors; }
-  void Execute(vtkObject*, unsigned long, void* data) override {
-    if (first.empty() && data) first = static_cast<const char*>(data);
-  }
-  std::string first;
-};
-
 // Reads through `r`; InputError naming the file when VTK reported an error.
 template <class Reader>
 vtkSmartPointer<vtkImageData> read_voxels(Reader* r, const std::string& name, const char* kind) {
-  vtkNew<ReadErrors> errors;
+  vtkNew<VtkReadErrors> errors;
   r->AddObserver(vtkCommand::ErrorEvent, errors);
   r->SetFileName(name.c_str());
   r->Update();
   if (!errors->first.empty() || r->GetErrorCode() != 0) {
-    std::string what = errors->first;
-    std::replace(what.begin(), what.end(), '\n', ' ');
+    const std::string& what = errors->first;
     throw InputError(fmt::format("{}: the {} voxel data could not be read ({}): is the file cut short or damaged?", name, kind,
                                  what.empty() ? "VTK error code " + std::to_string(r->GetErrorCode()) : what));
   }
