@@ -55,6 +55,12 @@ class Tokens {
     return static_cast<std::size_t>(n);
   }
   [[noreturn]] void fail(const std::string& msg) const { throw InputError(fmt::format("{}: {}", file_, msg)); }
+  /// Past the next blank line (the end of a METADATA block), or to the end of the file.
+  void skip_block() {
+    const std::size_t blank = text_.find("\n\n", at_), crlf = text_.find("\n\r\n", at_);
+    const std::size_t end = std::min(blank, crlf);
+    at_ = end == std::string::npos ? text_.size() : end + 2;
+  }
 
  private:
   void skip() {
@@ -64,26 +70,49 @@ class Tokens {
   std::size_t at_ = 0;
 };
 
+std::string upper(std::string w);
+
+// FIELD name n, then n arrays "name components tuples type" and their values: skipped, counts checked.
+void skip_field(Tokens& t) {
+  t.word("the FIELD name");
+  const std::size_t arrays = t.count("FIELD array count");
+  for (std::size_t a = 0; a < arrays; ++a) {
+    t.word("a FIELD array name");
+    const std::size_t components = t.count("FIELD array components");
+    const std::size_t tuples = t.count("FIELD array tuples", static_cast<long long>(components));
+    t.word("a FIELD array type");
+    for (std::size_t v = 0; v < components * tuples; ++v) t.word("a FIELD value");
+  }
+}
+
+std::string upper(std::string w) {
+  for (char& c : w) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return w;
+}
+
 // Cells as (count, ids...) lists or (5.1) OFFSETS + CONNECTIVITY; `add` gets each cell's ids.
 template <class Add>
 void read_cells(Tokens& t, const std::string& section, Add add) {
   const std::size_t n = t.count(section + " cell count");
-  const long long size = t.integer(section + " size");
+  const long long size = static_cast<long long>(t.count(section + " size"));
   std::vector<long long> ids;
   if (n == 0) return;
   std::string w = t.word(section + " cells");
-  if (w == "OFFSETS") {
+  if (upper(w) == "OFFSETS") {
+    // 5.1: n offsets (cells + 1) from 0 to `size`, then `size` point indices.
     t.word("the OFFSETS type");
-    std::vector<long long> offsets(n);  // n is the number of offsets here (cells + 1)
+    std::vector<long long> offsets(n);
     for (auto& o : offsets) o = t.integer(section + " offset");
-    if (t.word("CONNECTIVITY") != "CONNECTIVITY") t.fail(section + ": CONNECTIVITY expected after the offsets");
+    if (offsets.front() != 0 || offsets.back() != size)
+      t.fail(fmt::format("{}: the offsets run from {} to {}; expected 0 to the section's size {}", section, offsets.front(),
+                         offsets.back(), size));
+    for (std::size_t c = 0; c + 1 < offsets.size(); ++c)
+      if (offsets[c] > offsets[c + 1]) t.fail(fmt::format("{}: offset {} is smaller than the one before it", section, c + 2));
+    if (upper(t.word("CONNECTIVITY")) != "CONNECTIVITY") t.fail(section + ": CONNECTIVITY expected after the offsets");
     t.word("the CONNECTIVITY type");
-    const std::size_t m = offsets.back() >= 0 ? static_cast<std::size_t>(offsets.back()) : 0;
-    std::vector<long long> conn(m);
+    std::vector<long long> conn(static_cast<std::size_t>(size));
     for (auto& c : conn) c = t.integer(section + " point index");
     for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
-      if (offsets[c] < 0 || offsets[c] > offsets[c + 1] || offsets[c + 1] > static_cast<long long>(conn.size()))
-        t.fail(fmt::format("{}: offset {} is out of order or past the connectivity", section, c + 1));
       ids.assign(conn.begin() + offsets[c], conn.begin() + offsets[c + 1]);
       add(ids);
     }
@@ -92,7 +121,8 @@ void read_cells(Tokens& t, const std::string& section, Add add) {
   long long used = 0;  // integers read: each cell's count and its ids
   for (std::size_t c = 0; c < n; ++c) {
     const long long k = t.to_integer(w, section + " point count");
-    if (k < 0 || used + 1 + k > size) t.fail(fmt::format("{}: cell {} has {} points, past the section's size {}", section, c + 1, k, size));
+    if (k < 0 || k > size - used - 1)  // never forms used + 1 + k (a damaged k must not overflow)
+      t.fail(fmt::format("{}: cell {} has {} points, past the section's size {}", section, c + 1, k, size));
     ids.resize(static_cast<std::size_t>(k));
     for (auto& i : ids) i = t.integer(section + " point index");
     used += 1 + k;
@@ -114,6 +144,7 @@ std::optional<TriSurface> read_legacy_vtk_ascii(const std::filesystem::path& fil
   if (magic.rfind("# vtk DataFile", 0) != 0)
     throw InputError(fmt::format("{}: not a legacy VTK file (its first line is not '# vtk DataFile Version ...')", file.string()));
   while (!format.empty() && std::isspace(static_cast<unsigned char>(format.back()))) format.pop_back();
+  format = upper(format);
   if (format == "BINARY") return std::nullopt;
   if (format != "ASCII") throw InputError(fmt::format("{}: line 3 must be ASCII or BINARY", file.string()));
   in.clear();  // a file of three lines ends at EOF here
@@ -124,12 +155,17 @@ std::optional<TriSurface> read_legacy_vtk_ascii(const std::filesystem::path& fil
   std::string text = ss.str();
   const std::size_t header = pos < 0 ? text.size() : std::min(static_cast<std::size_t>(pos), text.size());
   Tokens t(std::move(text), header, file.string());
-  if (t.word("DATASET") != "DATASET" || t.word("the dataset type") != "POLYDATA")
-    t.fail("not a legacy VTK file with POLYDATA (an unstructured grid or image is not a surface)");
   TriSurface s;
+  std::string section = upper(t.word("DATASET"));
+  if (section == "FIELD") {  // dataset-level field data may come first
+    skip_field(t);
+    section = upper(t.word("DATASET"));
+  }
+  if (section != "DATASET" || upper(t.word("the dataset type")) != "POLYDATA")
+    t.fail("not a legacy VTK file with POLYDATA (an unstructured grid or image is not a surface)");
   bool have_points = false;
   while (!t.done()) {
-    const std::string section = t.word("a section");
+    section = upper(t.word("a section"));
     if (section == "POINTS") {
       const std::size_t n = t.count("POINTS", 3);
       t.word("the POINTS type");
@@ -152,7 +188,11 @@ std::optional<TriSurface> read_legacy_vtk_ascii(const std::filesystem::path& fil
       });
     } else if (section == "VERTICES" || section == "LINES") {
       read_cells(t, section, [](const std::vector<long long>&) {});
-    } else if (section == "POINT_DATA" || section == "CELL_DATA" || section == "FIELD" || section == "METADATA") {
+    } else if (section == "METADATA") {
+      t.skip_block();  // information keys (VTK 9 writes them after an array), up to a blank line
+    } else if (section == "FIELD") {
+      skip_field(t);
+    } else if (section == "POINT_DATA" || section == "CELL_DATA") {
       break;  // attributes: not needed for the surface
     } else {
       t.fail(fmt::format("unknown section '{}' (expected POINTS, POLYGONS, TRIANGLE_STRIPS, VERTICES, LINES or POINT_DATA)",

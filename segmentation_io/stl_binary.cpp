@@ -20,14 +20,15 @@ namespace {
 
 constexpr std::uintmax_t kHeader = 84, kRecord = 50;
 
-// ASCII STL: "solid" after optional white space, and the first kilobyte text.
+// ASCII STL: "solid" after optional white space, and the first kilobyte text (bytes of
+// 0x80 and above allowed: a UTF-8 or Latin-1 solid name) with no control characters.
 bool looks_ascii(const std::vector<char>& head) {
   std::size_t i = 0;
   while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) ++i;
   if (head.size() - i < 5 || std::strncmp(head.data() + i, "solid", 5) != 0) return false;
   return std::all_of(head.begin(), head.end(), [](char c) {
     const auto u = static_cast<unsigned char>(c);
-    return u == '\n' || u == '\r' || u == '\t' || (u >= 32 && u < 127);
+    return u == '\n' || u == '\r' || u == '\t' || (u >= 32 && u != 127);
   });
 }
 

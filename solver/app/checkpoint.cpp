@@ -48,7 +48,7 @@ std::map<std::string, std::string> state_fingerprint(const SceneDesc& scene, dou
   std::map<std::string, std::string> parts;
   for (const auto& [section, text] : scene.state_sections) parts["section " + section] = files::text_hash(text);
   for (const auto& f : scene.state_files)
-    parts["file " + f.lexically_relative(std::filesystem::absolute(scene.file).parent_path()).string()] = std::filesystem::exists(f) ? files::content_hash(f) : "missing";
+    parts["file " + f.lexically_relative(std::filesystem::absolute(scene.file).lexically_normal().parent_path()).string()] = std::filesystem::exists(f) ? files::content_hash(f) : "missing";
   for (const auto& [name, curve] : scene.curves) {
     // The points up to t and the value at t: what the loads were until the checkpoint.
     std::string text;

@@ -25,6 +25,11 @@ double reaction_norm(const Constraints& c, const Eigen::VectorXd& r) {
 
 NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linear, Eigen::VectorXd& u, double time,
                          double dt, const NewtonSettings& settings, const Eigen::VectorXd* guess) {
+  // The forcing term is this step's: the solver's own tolerance again on every way out.
+  struct RestoreTolerance {
+    LinearSolver& linear;
+    ~RestoreTolerance() { linear.set_relative_tolerance(0.0); }
+  } restore{linear};
   NewtonResult res;
   const Eigen::VectorXd u_start = u;
   auto fail = [&](std::string why) {
@@ -107,19 +112,20 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
   for (int it = 1; it <= settings.max_iterations; ++it) {
     res.iterations = it;
     if (settings.inexact) {
-      // Eisenstat-Walker choice 2 with its safeguard (header), at most eta_max; then never
-      // tighter than half of what the residual test, |R| <= tau, still asks (up to 0.5):
-      // once |R| is within tau the solve only serves the increment test.
+      // Eisenstat-Walker choice 2 with its safeguard (header), then Kelley's bound
+      // eta = min(eta_max, max(eta, 0.5 tau / |R|)) with tau the residual test's bound:
+      // never tighter than the residual test needs, never looser than eta_max (once |R| is
+      // within tau the solve serves the increment test, whose soft modes a loose solve
+      // would not resolve).
       constexpr double eta_max = 1e-2, gamma = 0.9;
       double e = eta_max;
       if (it > 1 && prev_r_norm > 0.0) {
         e = gamma * std::pow(r_norm / prev_r_norm, 2);
         if (gamma * eta * eta > 0.1) e = std::max(e, gamma * eta * eta);
-        e = std::min(e, eta_max);
       }
       const double tau = settings.residual_tolerance * scale + settings.residual_absolute;
-      if (r_norm > 0.0) e = std::max(e, std::min(0.5, 0.5 * tau / r_norm));
-      eta = e;
+      if (r_norm > 0.0) e = std::max(e, 0.5 * tau / r_norm);
+      eta = std::min(e, eta_max);
       if (!linear.set_relative_tolerance(eta)) eta = 0.0;
       prev_r_norm = r_norm;
     }

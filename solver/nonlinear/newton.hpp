@@ -18,9 +18,10 @@
 // far as the nonlinear one will follow. Iteration k stops its solve at
 // |b - A du| <= eta_k |b| with Eisenstat & Walker's choice 2 (SIAM J. Sci.
 // Comput. 17, 1996, Eq. 2.6 and its safeguard), eta_k = 0.9 (|R_k|/|R_k-1|)^2,
-// at most 1e-2, and never below half of what the residual test still asks
-// (Kelley 1995, Sec. 6.3): far from the solution a few Krylov iterations, near
-// it as accurate as quadratic convergence needs, and no oversolving at the end.
+// bounded as Kelley does (1995, Sec. 6.3): eta = min(1e-2, max(eta_k, 0.5 tau / |R_k|))
+// with tau the residual test's bound: far from the solution a few Krylov
+// iterations, near it as accurate as quadratic convergence needs, and no
+// oversolving at the end.
 #include <Eigen/Core>
 
 #include <string>

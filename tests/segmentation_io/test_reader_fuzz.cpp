@@ -6,6 +6,7 @@
 // runs more. A mutant that reads is a valid input: garbage results are the
 // targeted tests' to catch (test_surface_input.cpp).
 #include <gtest/gtest.h>
+#include <vtkPolyDataWriter.h>
 
 #include <unistd.h>
 
@@ -23,6 +24,7 @@
 #include "common/mesh_data.hpp"
 #include "segmentation_io/phantom.hpp"
 #include "segmentation_io/surface_input.hpp"
+#include "tests/segmentation_io/polydata_fixture.hpp"
 
 using namespace stentsim;
 using namespace stentsim::segmentation;
@@ -83,6 +85,16 @@ std::string legacy_vtk(const TriSurface& s) {
   return o;
 }
 
+// Legacy VTK as VTK 9.1's writer makes it (5.1: OFFSETS/CONNECTIVITY).
+std::string vtk51_text(const fs::path& dir, const TriSurface& s) {
+  auto w = vtkSmartPointer<vtkPolyDataWriter>::New();
+  w->SetInputData(to_polydata(s));
+  w->SetFileName((dir / "seed51.vtk").c_str());
+  w->Write();
+  std::ifstream in(dir / "seed51.vtk", std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 std::string vtp_text(const fs::path& dir, const TriSurface& s) {
   write_vtp((dir / "seed.vtp").string(), mesh_from_surface(s));
   std::ifstream in(dir / "seed.vtp", std::ios::binary);
@@ -135,7 +147,8 @@ TEST(ReaderFuzz, MutatedSurfacesReadOrFailWithAnInputError) {
   // parser, past what a check before it can see (seed 20261202, 300 mutants); such a file
   // has to be read in a child process, which is not built yet. STENTSIM_FUZZ_VTP=1 adds it.
   std::map<std::string, std::string> seeds = {{"ascii.stl", ascii_stl(tube)}, {"binary.stl", binary_stl(tube)},
-                                              {"t.obj", obj(tube)}, {"t.vtk", legacy_vtk(tube)}};
+                                              {"t.obj", obj(tube)}, {"t.vtk", legacy_vtk(tube)},
+                                              {"t51.vtk", vtk51_text(dir, tube)}};
   if (std::getenv("STENTSIM_FUZZ_VTP")) seeds["t.vtp"] = vtp_text(dir, tube);
   std::mt19937 gen(20261202);
   const int n = iterations();

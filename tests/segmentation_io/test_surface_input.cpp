@@ -2,7 +2,19 @@
 // and every check's repair or error message.
 #include <gtest/gtest.h>
 
+#include <vtkCellArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataWriter.h>
+#include <vtkSmartPointer.h>
+#include <vtkTriangleFilter.h>
+
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <set>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -15,6 +27,7 @@
 #include "segmentation_io/segmentation_stage.hpp"
 #include "segmentation_io/surface_distance.hpp"
 #include "segmentation_io/surface_input.hpp"
+#include "tests/segmentation_io/polydata_fixture.hpp"
 
 using namespace stentsim;
 using namespace stentsim::segmentation;
@@ -193,6 +206,48 @@ TEST(SurfaceReaders, OutOfRangeIndicesAndFoldersAreErrors) {
   }
   fs::create_directories(d / "folder.stl");
   EXPECT_CONTAINS(error_of([&] { read_surface_file(d / "folder.stl"); }), "not a regular file");
+  fs::remove_all(d);
+}
+
+// Legacy VTK as VTK 9.1's writer makes it (5.1: OFFSETS/CONNECTIVITY, dataset FIELD data
+// before the points, polygons and a triangle strip): stentsim's parser gives VTK's own
+// triangulation, orientation included.
+TEST(SurfaceReaders, LegacyVtkAsVtkWritesIt) {
+  const fs::path d = temp_dir("legacy_vtk51");
+  const TriSurface ref = small_tube();
+  auto pd = to_polydata(ref);
+  auto strips = vtkSmartPointer<vtkCellArray>::New();
+  const vtkIdType strip[5] = {0, 1, 24, 25, 2};
+  strips->InsertNextCell(5, strip);
+  pd->SetStrips(strips);
+  auto field = vtkSmartPointer<vtkDoubleArray>::New();
+  field->SetName("TimeValue");
+  field->InsertNextValue(0.5);
+  pd->GetFieldData()->AddArray(field);
+  auto w = vtkSmartPointer<vtkPolyDataWriter>::New();
+  w->SetInputData(pd);
+  w->SetFileName((d / "t.vtk").c_str());
+  w->Write();
+  const std::string text = [&] { std::ifstream f(d / "t.vtk"); return std::string(std::istreambuf_iterator<char>(f), {}); }();
+  ASSERT_NE(text.find("OFFSETS"), std::string::npos) << "not the 5.1 form";
+  ASSERT_NE(text.find("FIELD"), std::string::npos);
+  const TriSurface s = read_surface_file(d / "t.vtk");
+  auto tri = vtkSmartPointer<vtkTriangleFilter>::New();
+  tri->SetInputData(pd);
+  tri->Update();
+  std::set<std::array<int, 3>> vtk;  // each triangle rotated to start at its smallest index (orientation kept)
+  auto canon = [](std::array<int, 3> t) {
+    while (t[0] != std::min({t[0], t[1], t[2]})) std::rotate(t.begin(), t.begin() + 1, t.end());
+    return t;
+  };
+  vtkCellArray* out = tri->GetOutput()->GetPolys();
+  vtkIdType n = 0;
+  const vtkIdType* ids = nullptr;
+  for (out->InitTraversal(); out->GetNextCell(n, ids);) vtk.insert(canon({int(ids[0]), int(ids[1]), int(ids[2])}));
+  std::set<std::array<int, 3>> ours;
+  for (const auto& t : s.triangles) ours.insert(canon(t));
+  EXPECT_EQ(s.num_triangles(), ref.num_triangles() + 3);
+  EXPECT_EQ(ours, vtk);
   fs::remove_all(d);
 }
 
