@@ -108,7 +108,7 @@ std::vector<double> estimate_elements(const WallSections& w, const PatientMeshOp
   return count;
 }
 
-void check_element_budget(const WallSections& w, const PatientMeshOptions& o) {
+double check_element_budget(const WallSections& w, const PatientMeshOptions& o) {
   double thickest = 0;
   for (const auto& section : w.radius)
     for (std::size_t i = 0; !section.empty() && i < section[0].size(); ++i)
@@ -128,6 +128,7 @@ void check_element_budget(const WallSections& w, const PatientMeshOptions& o) {
     throw InputError(fmt::format("mesh: about {:.3g} tets are expected at mesh.size = {:g} mm ({}), more than "
                                  "mesh.max_elements = {:.3g}; raise mesh.size (the count goes with 1/size^3) or "
                                  "mesh.max_elements", total, o.size, per_layer, o.max_elements));
+  return total;
 }
 
 Vector3d WallSections::point(std::size_t s, std::size_t k, std::size_t i) const {
@@ -398,9 +399,7 @@ void run_patient_mesh(const std::filesystem::path& lumen_vtp, const std::filesys
     log::warn("mesh: on {:.1f} % of the rays the wall is thinner than media + adventitia + min_intima; media and adventitia shrink there",
               100 * w.clamped_fraction);
   // gmsh picks the format from the extension: the temporary keeps ".msh".
-  check_element_budget(w, o);
-  const std::vector<double> estimate = estimate_elements(w, o);
-  const double estimated = std::accumulate(estimate.begin(), estimate.end(), 0.0);
+  const double estimated = check_element_budget(w, o);
   log::info("mesh: about {:.3g} tets expected; meshing with gmsh", estimated);
   const auto msh_tmp = artery_msh.parent_path() / (".tmp-" + artery_msh.filename().string());
   MeshData m = mesh_wall_sections(w, o, msh_tmp);

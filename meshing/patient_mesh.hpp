@@ -102,8 +102,9 @@ std::vector<double> estimate_elements(const WallSections& w, const PatientMeshOp
 /// InputError naming mesh.size, mesh.max_elements and the estimate when the estimated
 /// count is above o.max_elements, or when the size is so large that a layer's floor
 /// (min_size_ratio * size) exceeds the whole wall's thickness many times over (gmsh
-/// crashes on such input). Called by run_patient_mesh before gmsh runs.
-void check_element_budget(const WallSections& w, const PatientMeshOptions& o);
+/// crashes on such input). Called by run_patient_mesh before gmsh runs; returns the
+/// estimated total.
+double check_element_budget(const WallSections& w, const PatientMeshOptions& o);
 
 struct MeshQuality {
   /// Minimum over the tets of the corner scaled Jacobian of the straight-sided

@@ -186,6 +186,10 @@ void check_metaimage_data_size(const std::filesystem::path& file) {
       in >> channels;
     } else if (key == "CompressedData") {
       compressed = value == "True" || value == "true";
+    } else if (key == "BinaryData" && (value == "False" || value == "false")) {
+      compressed = true;  // text voxels: their byte count says nothing (the reader checks them)
+    } else if (key == "HeaderSize") {
+      compressed = true;  // a header of its own size before the data (-1: at the end): left to the reader
     } else if (key == "ElementDataFile") {
       data_file = value;
       break;  // the last header field

@@ -180,8 +180,6 @@ TriSurface load_checked_surface(const std::filesystem::path& file, const Surface
   return check_and_repair(std::move(raw), checks, file.string(), report);
 }
 
-namespace {
-
 void report_to_summary(const std::string& prefix, const SurfaceReport& r, Summary& s) {
   s.set(prefix + "_merged_points", r.merged_points);
   s.set(prefix + "_degenerate_triangles_removed", r.degenerate_triangles);
@@ -193,6 +191,8 @@ void report_to_summary(const std::string& prefix, const SurfaceReport& r, Summar
   s.set(prefix + "_open_ends", r.open_ends);
   for (std::size_t i = 0; i < r.notes.size(); ++i) s.note(fmt::format("{}_repair_{}", prefix, i + 1), r.notes[i]);
 }
+
+namespace {
 
 MeshData to_output(const TriSurface& s, const std::string& source) {
   MeshData m = mesh_from_surface(s);

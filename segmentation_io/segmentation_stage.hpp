@@ -133,6 +133,9 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
 TriSurface load_checked_surface(const std::filesystem::path& file, const SurfaceCheckOptions& checks,
                                 SurfaceReport& report);
 
+/// The report's counts and repair notes as `<prefix>_...` QoIs and notes of `summary`.
+void report_to_summary(const std::string& prefix, const SurfaceReport& report, Summary& summary);
+
 /// The synthesized outer wall for a lumen (open tube, outward normals).
 /// Summary: wall_thickness_min/max/reference, the fractions of missing and
 /// flared rays, wall_min_clearance_ratio (smallest wall-to-lumen distance

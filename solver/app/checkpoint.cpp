@@ -44,11 +44,18 @@ SolverCheckpoint SolverCheckpoint::get(const HistoryArchive& in, long long dofs)
   return c;
 }
 
-std::map<std::string, std::string> state_fingerprint(const SceneDesc& scene, double t) {
+std::map<std::string, std::string> scene_state_hashes(const SceneDesc& scene) {
   std::map<std::string, std::string> parts;
   for (const auto& [section, text] : scene.state_sections) parts["section " + section] = files::text_hash(text);
+  const std::filesystem::path dir = std::filesystem::absolute(scene.file).lexically_normal().parent_path();
   for (const auto& f : scene.state_files)
-    parts["file " + f.lexically_relative(std::filesystem::absolute(scene.file).lexically_normal().parent_path()).string()] = std::filesystem::exists(f) ? files::content_hash(f) : "missing";
+    parts["file " + f.lexically_relative(dir).string()] = std::filesystem::exists(f) ? files::content_hash(f) : "missing";
+  return parts;
+}
+
+std::map<std::string, std::string> state_fingerprint(const SceneDesc& scene, const std::map<std::string, std::string>& scene_parts,
+                                                     double t) {
+  std::map<std::string, std::string> parts = scene_parts;
   for (const auto& [name, curve] : scene.curves) {
     // The points up to t and the value at t: what the loads were until the checkpoint.
     std::string text;

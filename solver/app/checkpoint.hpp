@@ -37,7 +37,11 @@ struct SceneDesc;
 /// and each load curve up to t. Not the end time, the output, the QoIs, the solver
 /// settings or the rank count: a run may be resumed with more steps, other outputs or
 /// on other ranks, and a curve may be extended beyond t.
-std::map<std::string, std::string> state_fingerprint(const SceneDesc& scene, double t);
+/// `scene_parts`: scene_state_hashes(scene), computed once per run (it hashes the files).
+std::map<std::string, std::string> state_fingerprint(const SceneDesc& scene, const std::map<std::string, std::string>& scene_parts,
+                                                     double t);
+/// The parts that do not depend on time: sections and files.
+std::map<std::string, std::string> scene_state_hashes(const SceneDesc& scene);
 
 /// Records it in the checkpoint ("solver/state/<part>").
 void put_fingerprint(HistoryArchive& out, const std::map<std::string, std::string>& parts);

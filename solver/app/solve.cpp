@@ -71,11 +71,13 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   const std::filesystem::path checkpoint_file = out_dir / "checkpoint.bin";
   RunCounters counters;
   double t_last = stepping.t_start;
+  const std::map<std::string, std::string> scene_hashes = scene_state_hashes(scene);  // the files as this run read them
   if (options.restart) {
     const std::filesystem::path from = options.restart->empty() ? checkpoint_file : *options.restart;
     const HistoryArchive ck = HistoryArchive::read(from);
     // Before the state's size: another scene's checkpoint is named as such.
-    check_fingerprint(ck, state_fingerprint(scene, ck.get_scalar("solver/time")), from.string(), scene.file.string());
+    check_fingerprint(ck, state_fingerprint(scene, scene_hashes, ck.get_scalar("solver/time")), from.string(),
+                      scene.file.string());
     const SolverCheckpoint state = SolverCheckpoint::get(ck, model.dofs.size());
     u = state.u;
     model.load_history(ck);
@@ -122,7 +124,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     if (scene.checkpoint_every > 0 && r.step % scene.checkpoint_every == 0 && writes) {
       HistoryArchive ck;
       SolverCheckpoint{u, r.time, r.next_dt, r.increment, r.dt, counters}.put(ck);
-      put_fingerprint(ck, state_fingerprint(scene, r.time));
+      put_fingerprint(ck, state_fingerprint(scene, scene_hashes, r.time));
       for (const auto& [prefix, o] : observers) o->save(ck, prefix);
       model.save_history(ck);
       writer.save(ck);

@@ -76,7 +76,7 @@ void register_segmentation(CLI::App& app) {
     checks.units = c->units;
     segmentation::SurfaceReport report;
     const segmentation::TriSurface lumen = segmentation::load_checked_surface(c->lumen, checks, report);
-    for (std::size_t i = 0; i < report.notes.size(); ++i) summary.note("lumen_repair_" + std::to_string(i + 1), report.notes[i]);
+    segmentation::report_to_summary("lumen", report, summary);
     segmentation::run_centerline_stage(o, segmentation::mesh_from_surface(lumen), c->lumen, c->out, summary);
     summary.write(std::filesystem::path(c->out).parent_path() / "summary.yaml");
     return 0;
