@@ -34,6 +34,7 @@ struct Artifacts {
 /// "after" are the ends of the phases.
 struct Phases {
   bool artery;
+  bool patient;  // segmented three-layer artery, device warped along the placement's centerline
   double T;
   double prestress() const { return artery ? T : 0.0; }
   double max() const { return prestress() + T; }
@@ -65,9 +66,12 @@ std::string header(const CaseConfig& c, const Phases& ph) {
       "description: {desc}\n\n",
       fmt::arg("case", c.file.string()), fmt::arg("scene", to_string(c.scene)),
       fmt::arg("desc", quoted(fmt::format("{} '{}', p_max {:g} MPa", to_string(c.scene), c.name, c.simulation.pressure_max))),
-      fmt::arg("what", ph.artery ? "Generic artery (paper 4.1): artery (media, adventitia) with fibers, balloon, stent; "
-                                   "stent–balloon and stent–artery beam-to-surface, balloon–artery surface-to-surface contact."
-                                 : "Free expansion (paper 3.1): balloon + stent, stent–balloon beam-to-surface contact."),
+      fmt::arg("what", ph.patient  ? "Patient (paper 4.2): segmented artery (intima, media, adventitia) with the fibers stage's "
+                                     "fibers, balloon and stent warped along the placement's centerline; stent–balloon and "
+                                     "stent–artery beam-to-surface, balloon–artery surface-to-surface contact."
+                       : ph.artery ? "Generic artery (paper 4.1): artery (media, adventitia) with fibers, balloon, stent; "
+                                     "stent–balloon and stent–artery beam-to-surface, balloon–artery surface-to-surface contact."
+                                   : "Free expansion (paper 3.1): balloon + stent, stent–balloon beam-to-surface contact."),
       fmt::arg("phases", ph.artery ? fmt::format("prestress to t {:g} (diastolic pressure, held), inflation to t {:g} (\"max\"), "
                                                  "deflation to t {:g} (\"after\")",
                                                  ph.prestress(), ph.max(), ph.after())
@@ -82,11 +86,16 @@ std::string bodies(const CaseConfig& c, const Artifacts& a, const Phases& ph) {
       "    mesh: {{file: {b}}}\n"
       "    materials:\n"
       "      - preset: balloon          # neo-Hooke E 17 MPa, ν 0; longitudinal and circumferential fibers; viscous branch\n"
-      "    fiber_frames:                # the straight balloon's axis: frames exact at every Gauss point\n"
-      "      cylindrical: {{origin: [0, 0, 0], axis: [0, 0, 1]}}\n"
+      "{frames}"
       "  - name: stent\n"
       "    beam: {{file: {st}, material: stent, joints: rigid}}   # App. C elasto-plastic beams\n",
-      fmt::arg("b", quoted(a.balloon)), fmt::arg("st", quoted(a.stent)));
+      fmt::arg("b", quoted(a.balloon)), fmt::arg("st", quoted(a.stent)),
+      fmt::arg("frames", ph.patient ? fmt::format("    fiber_frames:                # warped balloon: the balloon stage's frames per cell; "
+                                                  "fibers from the material's angles\n"
+                                                  "      {{file: {}, fibers: none}}\n",
+                                                  quoted(a.balloon))
+                                    : "    fiber_frames:                # the straight balloon's axis: frames exact at every Gauss point\n"
+                                      "      cylindrical: {origin: [0, 0, 0], axis: [0, 0, 1]}\n"));
   if (ph.artery) {
     const std::string tension = c.fibers.tension_only ? ", tension_only_fibers: true" : "";
     y += fmt::format(
@@ -94,11 +103,15 @@ std::string bodies(const CaseConfig& c, const Artifacts& a, const Phases& ph) {
         "    mesh: {{file: {art}}}\n"
         "    material_array: Layer\n"
         "    materials:                   # App. B: coupled neo-Hooke + two fiber families + viscous branch\n"
+        "{intima}"
         "      - {{tag: {media}, preset: media{t}}}\n"
         "      - {{tag: {adv}, preset: adventitia{t}}}\n"
         "    fiber_frames: {{file: {fib}}}   # the fibers stage's frames and Fiber1, Fiber2\n",
         fmt::arg("art", quoted(a.artery)), fmt::arg("fib", quoted(a.fibers)), fmt::arg("media", static_cast<int>(tags::media)),
-        fmt::arg("adv", static_cast<int>(tags::adventitia)), fmt::arg("t", tension));
+        fmt::arg("adv", static_cast<int>(tags::adventitia)), fmt::arg("t", tension),
+        fmt::arg("intima", ph.patient ? fmt::format("      - {{tag: {}, preset: media{}}}   # intima: as media (DESIGN.md §5)\n",
+                                                    static_cast<int>(tags::intima), tension)
+                                      : ""));
   }
   return y + "\n";
 }
@@ -193,7 +206,11 @@ std::string qois(const CaseConfig& c, const Phases& ph) {
       "    type: stent_expansion          # ring diameters, recoil, dogboning (DESIGN.md §8), centroid curvature\n"
       "    body: stent\n"
       "    pressure: inflation\n"
-      "    times: {times}\n"
+      "    times: {times}\n",
+      fmt::arg("times", ph.times()));
+  // The balloon's profile along its axis needs a straight balloon.
+  if (!ph.patient)
+    y += fmt::format(
       "  - name: balloon\n"
       "    type: balloon_profile          # outer diameter along the (straight) axis\n"
       "    body: balloon\n"
@@ -209,15 +226,18 @@ std::string qois(const CaseConfig& c, const Phases& ph) {
         "    type: layer_stresses           # max principal Cauchy stress per layer: Gauss-point maximum and nodal-averaged\n"
         "    body: artery\n"
         "    layer_array: Layer\n"
-        "    layers: {{media: {media}, adventitia: {adv}}}\n"
+        "    layers: {{{intima}media: {media}, adventitia: {adv}}}\n"
         "    endothelium: {endo}\n"
         "    times: {times}\n",
         fmt::arg("media", static_cast<int>(tags::media)), fmt::arg("adv", static_cast<int>(tags::adventitia)),
-        fmt::arg("endo", selector(tags::endothelium)), fmt::arg("times", ph.times()));
+        fmt::arg("endo", selector(tags::endothelium)), fmt::arg("times", ph.times()),
+        fmt::arg("intima", ph.patient ? fmt::format("intima: {}, ", static_cast<int>(tags::intima)) : ""));
   return y;
 }
 
-Phases phases(const CaseConfig& c) { return {c.scene == Scene::generic_artery, c.simulation.phase_duration}; }
+Phases phases(const CaseConfig& c) {
+  return {c.scene != Scene::free_expansion, c.scene == Scene::patient, c.simulation.phase_duration};
+}
 
 /// The comments and description (the case's name and file: not physics).
 std::string scene_header(const CaseConfig& c) { return header(c, phases(c)); }
@@ -230,10 +250,6 @@ std::string scene_body(const CaseConfig& c, const Artifacts& a) {
 
 /// The scene text with the artifacts' paths as given.
 std::string scene_text(const CaseConfig& c, const Artifacts& a) {
-  if (c.scene == Scene::patient)
-    throw InputError(fmt::format("{}: scene 'patient': this version builds the solve stage for free-expansion and "
-                                 "generic-artery scenes only",
-                                 c.file.string()));
   return scene_header(c) + scene_body(c, a);
 }
 
@@ -284,7 +300,6 @@ std::string contact_face_size_warning(const fs::path& artery_vtu, double strut_d
   return msg;
 }
 
-bool solve_stage_available(const CaseConfig& c) { return c.scene != Scene::patient; }
 
 std::string solve_scene_text(const CaseConfig& c) { return scene_text(c, artifacts(c, {})); }
 

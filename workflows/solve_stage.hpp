@@ -13,9 +13,6 @@
 
 namespace stentsim::workflows {
 
-/// Does this version build the solve stage for the case's scene?
-bool solve_stage_available(const CaseConfig& c);
-
 /// DESIGN.md §8 (paper 2.5): the artery's contact faces should be no smaller
 /// than the strut diameter. Empty when they are; else the warning (also logged)
 /// naming the file, how many endothelium faces are smaller and the shortest edge.

@@ -210,7 +210,8 @@ Eigen::MatrixXd amg_near_null_space(const SceneDesc& scene, const BuiltModel& b)
   const std::string where = fmt::format("{}: solver.linear.type: gmres_amg", scene.file.string());
   if (!b.beams.empty())
     throw InputError(fmt::format("{} needs 3 displacement DOFs per node, but body '{}' is a beam body (6-9 DOFs per node); "
-                                 "use direct or gmres_ilu", where, b.beams.begin()->first));
+                                 "use gmres_amg_block (AMG on the largest solid body, LU on the rest), direct or gmres_ilu",
+                                 where, b.beams.begin()->first));
   GlobalDof solid = 0;
   std::vector<std::pair<GlobalDof, Vec3>> nodes;
   for (const auto& [name, body] : b.bodies) {
@@ -224,6 +225,32 @@ Eigen::MatrixXd amg_near_null_space(const SceneDesc& scene, const BuiltModel& b)
   for (const auto& [d0, x] : nodes)
     if (const Mat3* q = model.constraints.frame(d0)) modes.middleRows<3>(d0) = q->transpose() * modes.middleRows<3>(d0);
   return modes;
+}
+
+AmgBlock amg_block(const SceneDesc& scene, const BuiltModel& b) {
+  const Model& model = b.model;
+  const std::string where = fmt::format("{}: solver.linear.type: gmres_amg_block", scene.file.string());
+  const SolidBody* largest = nullptr;
+  std::string name;
+  for (const auto& [n, body] : b.bodies)
+    if (!largest || body->num_dofs() > largest->num_dofs()) largest = body, name = n;
+  if (!largest) throw InputError(fmt::format("{} needs a solid body for its AMG block; use direct or gmres_ilu", where));
+  if (largest->num_dofs() == model.dofs.size())
+    throw InputError(fmt::format("{}: body '{}' holds every unknown, so there is no second block; use gmres_amg", where, name));
+  AmgBlock out;
+  out.body = name;
+  out.begin = largest->first_dof();
+  out.end = out.begin + largest->num_dofs();
+  std::vector<std::pair<GlobalDof, Vec3>> nodes;
+  out.coordinates.resize(static_cast<Eigen::Index>(largest->num_nodes()), 3);
+  for (std::size_t i = 0; i < largest->num_nodes(); ++i) {
+    nodes.emplace_back(largest->dof(i, 0) - out.begin, largest->mesh().points[i]);
+    out.coordinates.row(static_cast<Eigen::Index>(i)) = largest->mesh().points[i].transpose();
+  }
+  out.modes = model.rigid_body_modes(nodes).topRows(out.end - out.begin);  // rows numbered within the block
+  for (const auto& [d0, x] : nodes)
+    if (const Mat3* q = model.constraints.frame(d0 + out.begin)) out.modes.middleRows<3>(d0) = q->transpose() * out.modes.middleRows<3>(d0);
+  return out;
 }
 
 Eigen::MatrixXd amg_node_coordinates(const BuiltModel& b) {

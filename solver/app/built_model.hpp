@@ -53,4 +53,16 @@ Eigen::MatrixXd amg_near_null_space(const SceneDesc& scene, const BuiltModel& b)
 /// (call after amg_near_null_space, which checks that every unknown is a solid displacement).
 Eigen::MatrixXd amg_node_coordinates(const BuiltModel& b);
 
+/// gmres_amg_block's AMG block: the largest solid body's unknowns [begin, end)
+/// (a solid body's DOFs are contiguous, 3 per node), with that block's
+/// rigid-body modes and node coordinates.
+struct AmgBlock {
+  std::string body;
+  GlobalDof begin = 0, end = 0;
+  Eigen::MatrixXd modes, coordinates;
+};
+/// InputError naming the scene's solver.linear.type when the scene has no
+/// solid body or nothing outside it (then gmres_amg is the solver to use).
+AmgBlock amg_block(const SceneDesc& scene, const BuiltModel& b);
+
 }  // namespace stentsim::solver

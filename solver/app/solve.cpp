@@ -46,6 +46,14 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     linear->set_near_null_space(amg_near_null_space(scene, *built));
     linear->set_node_coordinates(amg_node_coordinates(*built));
   }
+  if (linear_settings.type == LinearSolverType::gmres_amg_block) {
+    const AmgBlock block = amg_block(scene, *built);
+    linear->set_amg_block(block.begin, block.end);
+    linear->set_near_null_space(block.modes);
+    linear->set_node_coordinates(block.coordinates);
+    log::info("gmres_amg_block: AMG on body '{}' ({} unknowns), UMFPACK LU on the other {}", block.body, block.end - block.begin,
+              model.dofs.size() - (block.end - block.begin));
+  }
   // Ranks: after the linear solver exists (Trilinos initialises MPI when the
   // CLI has not). Every rank holds u; elements are split; rank 0 writes.
   model.rank = parallel::rank();

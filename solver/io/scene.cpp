@@ -353,7 +353,8 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   scene.linear.ilu_fill = li.integer("ilu_fill", 4, Range::between(0, 20));
   scene.linear.verbosity = li.integer("verbosity", 0, Range::between(0, 2));
   if (li.has("amg_parameters")) {
-    if (scene.linear.type != LinearSolverType::gmres_amg) li.fail("amg_parameters", "applies to type: gmres_amg only");
+    if (scene.linear.type != LinearSolverType::gmres_amg && scene.linear.type != LinearSolverType::gmres_amg_block)
+      li.fail("amg_parameters", "applies to types gmres_amg and gmres_amg_block only");
     const auto xml = li.path("amg_parameters");
     if (!std::filesystem::is_regular_file(xml)) li.fail("amg_parameters", fmt::format("no such file: {}", xml.string()));
     scene.linear.amg_parameters = xml.string();

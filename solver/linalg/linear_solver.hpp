@@ -16,8 +16,11 @@ namespace stentsim::solver {
 
 /// direct: UMFPACK sparse LU; gmres_ilu: Belos GMRES + Ifpack2 RILUK;
 /// gmres_amg: Belos GMRES + MueLu SA-AMG (rigid-body near-null space);
-/// eigen_lu: Eigen's SparseLU (single rank, a dependency-light reference).
-enum class LinearSolverType { direct, gmres_ilu, gmres_amg, eigen_lu };
+/// eigen_lu: Eigen's SparseLU (single rank, a dependency-light reference);
+/// gmres_amg_block: Belos GMRES + block Gauss-Seidel (block_split.hpp): MueLu
+/// SA-AMG on one solid body's unknowns (set_amg_block), UMFPACK LU on the
+/// rest (beams, a thin balloon: the unknowns AMG cannot aggregate). One rank.
+enum class LinearSolverType { direct, gmres_ilu, gmres_amg, eigen_lu, gmres_amg_block };
 
 /// The names every input accepts (scene, case, fibers stage, CLI), in enum order.
 const std::vector<std::string>& linear_solver_names();
@@ -67,6 +70,10 @@ class LinearSolver {
   /// AMG: the mesh nodes' coordinates (row i: the node of unknowns eq*i .. eq*i+eq-1),
   /// for MueLu's geometric options (a distance-Laplacian drop); ignored by others.
   virtual void set_node_coordinates(const Eigen::MatrixXd& xyz) {}
+  /// gmres_amg_block: the unknowns [begin, end) (one solid body, 3 per node) that
+  /// AMG takes; the near-null space and the coordinates above are then that
+  /// block's (end − begin rows, and (end − begin)/3). Ignored by the others.
+  virtual void set_amg_block(std::int64_t begin, std::int64_t end) {}
   /// Krylov solvers: the relative residual at which the following solves stop
   /// (an inexact Newton's forcing term), never tighter than the settings'
   /// tolerance; 0 restores that. Returns false for direct solvers, which ignore it.

@@ -9,7 +9,7 @@
 namespace stentsim::solver {
 
 const std::vector<std::string>& linear_solver_names() {
-  static const std::vector<std::string> names{"direct", "gmres_ilu", "gmres_amg", "eigen_lu"};
+  static const std::vector<std::string> names{"direct", "gmres_ilu", "gmres_amg", "eigen_lu", "gmres_amg_block"};
   return names;
 }
 

@@ -27,7 +27,9 @@
 #include <vector>
 
 #include "common/error.hpp"
+#include "solver/linalg/block_split.hpp"
 #include "solver/linalg/linear_solver.hpp"
+#include "solver/linalg/umfpack_factor.hpp"
 
 namespace stentsim::solver {
 namespace {
@@ -56,6 +58,49 @@ void ensure_initialized() {
   std::atexit([] { Tpetra::finalize(); });
 }
 
+// gmres_amg_block's preconditioner (block_split.hpp): one forward block
+// Gauss-Seidel sweep, AMG on block 1 then the direct solve of block 2 (one rank).
+class BlockGaussSeidel : public OP {
+ public:
+  BlockGaussSeidel(RCP<const Map> map, RCP<const Map> map1, RCP<OP> amg, const BlockSplit& split, const UmfpackFactor& lu)
+      : map_(std::move(map)), map1_(std::move(map1)), amg_(std::move(amg)), split_(split), lu_(lu) {}
+  RCP<const Map> getDomainMap() const override { return map_; }
+  RCP<const Map> getRangeMap() const override { return map_; }
+  void apply(const MV& x, MV& y, Teuchos::ETransp mode = Teuchos::NO_TRANS, SC alpha = Teuchos::ScalarTraits<SC>::one(),
+             SC beta = Teuchos::ScalarTraits<SC>::zero()) const override {
+    if (mode != Teuchos::NO_TRANS) throw std::logic_error("gmres_amg_block: the preconditioner has no transpose");
+    const std::int64_t n1 = split_.end - split_.begin, n2 = split_.a22.rows;
+    MV r1(map1_, 1), y1(map1_, 1);
+    Eigen::VectorXd y1e(n1), r2(n2), y2;
+    for (std::size_t j = 0; j < x.getNumVectors(); ++j) {
+      const auto xd = x.getData(j);
+      {
+        auto rd = r1.getDataNonConst(0);
+        for (std::int64_t i = 0; i < n1; ++i) rd[i] = xd[split_.begin + i];
+      }
+      amg_->apply(r1, y1);
+      {
+        const auto yd = y1.getData(0);
+        for (std::int64_t i = 0; i < n1; ++i) y1e(i) = yd[i];
+      }
+      for (std::int64_t k = 0; k < n2; ++k) r2(k) = xd[split_.full_of_outer(k)];
+      r2 -= split_.a21.multiply(y1e);
+      lu_.solve(r2, y2);
+      auto out = y.getDataNonConst(j);
+      // beta = 0 overwrites y (which may hold garbage, Tpetra's convention).
+      auto put = [&](std::int64_t i, double v) { out[i] = beta == 0.0 ? alpha * v : alpha * v + beta * out[i]; };
+      for (std::int64_t i = 0; i < n1; ++i) put(split_.begin + i, y1e(i));
+      for (std::int64_t k = 0; k < n2; ++k) put(split_.full_of_outer(k), y2(k));
+    }
+  }
+
+ private:
+  RCP<const Map> map_, map1_;
+  RCP<OP> amg_;
+  const BlockSplit& split_;
+  const UmfpackFactor& lu_;
+};
+
 class TrilinosSolver : public LinearSolver {
  public:
   explicit TrilinosSolver(LinearSolverSettings s) : settings_(std::move(s)) {
@@ -65,6 +110,7 @@ class TrilinosSolver : public LinearSolver {
 
   void set_near_null_space(const Eigen::MatrixXd& modes) override { modes_ = modes; }
   void set_node_coordinates(const Eigen::MatrixXd& xyz) override { coordinates_ = xyz; }
+  void set_amg_block(std::int64_t begin, std::int64_t end) override { block_begin_ = begin, block_end_ = end; }
 
   bool set_relative_tolerance(double tolerance) override {
     requested_tolerance_ = tolerance;
@@ -77,9 +123,12 @@ class TrilinosSolver : public LinearSolver {
     std::ostringstream o;
     o << "Belos block GMRES (Krylov space " << settings_.krylov_size << ", tol " << settings_.tolerance << ") + ";
     if (settings_.type == LinearSolverType::gmres_ilu) o << "Ifpack2 ILU(" << settings_.ilu_fill << ")";
+    else if (settings_.type == LinearSolverType::gmres_amg_block)
+      o << "block Gauss-Seidel: MueLu smoothed-aggregation AMG on unknowns [" << block_begin_ << ", " << block_end_
+        << "), UMFPACK LU on the others";
     else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space, symmetric Gauss-Seidel)";
     else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node, symmetric Gauss-Seidel)";
-    if (settings_.type == LinearSolverType::gmres_amg && !settings_.amg_parameters.empty())
+    if (settings_.type != LinearSolverType::gmres_ilu && !settings_.amg_parameters.empty())
       o << ", MueLu parameters from " << settings_.amg_parameters;
     return o.str();
   }
@@ -87,6 +136,10 @@ class TrilinosSolver : public LinearSolver {
   LinearSolveStats solve(const CsrMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x) override {
     // One rank: its contributions are the whole matrix, no Tpetra copy needed.
     if (settings_.type == LinearSolverType::direct && comm_->getSize() == 1) return direct_->solve(a, b, x);
+    const bool block = settings_.type == LinearSolverType::gmres_amg_block;
+    if (block && comm_->getSize() > 1)
+      throw InputError("linear.type gmres_amg_block runs on one MPI rank in this version; on " +
+                       std::to_string(comm_->getSize()) + " ranks use direct or gmres_ilu");
     LinearSolveStats stats;
     const auto t0 = Clock::now();
     const GO n = static_cast<GO>(a.rows);
@@ -105,9 +158,11 @@ class TrilinosSolver : public LinearSolver {
     // prolongator's smoothing on the first matrix's values (the peer tube's GMRES
     // counts stayed as after a fresh set-up over its 20 steps; a test bounds the
     // cost of a matrix whose anisotropy turns, test_solver_linear_reuse).
-    const bool keep = (settings_.type == LinearSolverType::gmres_ilu || settings_.type == LinearSolverType::gmres_amg) &&
-                      comm_->getSize() == 1;
-    const bool reuse = keep && kept_prec_ && a.row_ptr == kept_row_ptr_ && a.cols == kept_cols_;
+    //
+    // gmres_amg_block keeps the whole matrix likewise, and its blocks' AMG and LU
+    // while block 1's pattern stays (block_preconditioner).
+    const bool keep = settings_.type != LinearSolverType::direct && comm_->getSize() == 1;
+    const bool reuse = keep && kept_matrix_ && a.row_ptr == kept_row_ptr_ && a.cols == kept_cols_;
     RCP<const Map> map;
     RCP<Matrix> mat;
     if (reuse) {
@@ -133,7 +188,10 @@ class TrilinosSolver : public LinearSolver {
     }
     {
       RCP<OP> prec;
-      if (reuse) {
+      if (block) {
+        prec = block_preconditioner(a, map, stats);
+        if (!reuse) kept_matrix_ = mat, kept_row_ptr_ = a.row_ptr, kept_cols_ = a.cols;
+      } else if (reuse) {
         if (auto ilu = Teuchos::rcp_dynamic_cast<Ifpack2::Preconditioner<SC, LO, GO, NO>>(kept_prec_)) {
           ilu->compute();
         } else {
@@ -274,6 +332,42 @@ class TrilinosSolver : public LinearSolver {
     return stats;
   }
 
+  // gmres_amg_block: split, AMG on block 1 (its prolongators kept while its
+  // pattern stays, as gmres_amg's), UMFPACK on block 2 (its analysis kept likewise).
+  RCP<OP> block_preconditioner(const CsrMatrix& a, const RCP<const Map>& map, LinearSolveStats& stats) {
+    if (block_end_ <= block_begin_)
+      throw std::logic_error("gmres_amg_block: no AMG block was set (set_amg_block)");
+    split_ = split_blocks(a, block_begin_, block_end_);
+    bool same = block_amg_ && split_.a11.row_ptr == block_row_ptr_ && split_.a11.cols == block_cols_;
+    if (same) {
+      refill(*block_matrix_, split_.a11);
+      // Contact terms reserve entries that stay exactly zero until a point comes
+      // within reach; the kept coarse operators' static graphs miss the products
+      // of such entries once they fill (Tpetra: "insert a new entry into a static
+      // graph"). The hierarchy is then built afresh for the new values.
+      try {
+        MueLu::ReuseTpetraPreconditioner(block_matrix_, *block_amg_);
+      } catch (const std::exception& e) {
+        std::string what = e.what();
+        if (settings_.verbosity > 0)
+          std::fprintf(stderr, "gmres_amg_block: the kept AMG hierarchy does not take the new values (%s); building it afresh\n",
+                       what.substr(0, what.find('\n', what.find_first_not_of('\n'))).c_str());
+        same = false;
+      }
+    }
+    if (!same) {
+      RCP<const Map> map1 = rcp(new Map(static_cast<GO>(split_.a11.rows), 0, comm_));
+      block_matrix_ = build_matrix(split_.a11, map1);
+      block_amg_ = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(
+          make_preconditioner(block_matrix_, map1, stats, true), true);
+      block_row_ptr_ = split_.a11.row_ptr;
+      block_cols_ = split_.a11.cols;
+    }
+    stats.amg_levels = block_amg_->GetHierarchy()->GetNumLevels();
+    block_lu_.factor(split_.a22);
+    return rcp(new BlockGaussSeidel(map, block_matrix_->getRowMap(), block_amg_, split_, block_lu_));
+  }
+
   // SA-AMG needs a near-null space that describes every row with the fixed
   // block size: a silently dropped or partly zero null space gives a coarse
   // space without the rigid-body modes (slow or stalled GMRES) and no message.
@@ -314,7 +408,7 @@ class TrilinosSolver : public LinearSolver {
       prec->compute();
       return prec;
     }
-    if (settings_.type == LinearSolverType::gmres_amg) {
+    if (settings_.type == LinearSolverType::gmres_amg || settings_.type == LinearSolverType::gmres_amg_block) {
       Teuchos::ParameterList p;
       p.set("verbosity", std::string(settings_.verbosity > 0 ? "low" : "none"));
       p.set("multigrid algorithm", std::string("sa"));
@@ -387,6 +481,13 @@ class TrilinosSolver : public LinearSolver {
   RCP<Matrix> kept_matrix_;
   RCP<OP> kept_prec_;
   std::vector<std::int64_t> kept_row_ptr_, kept_cols_;
+  // gmres_amg_block: block 1's range, the split, its AMG (with its matrix and pattern) and block 2's LU.
+  std::int64_t block_begin_ = 0, block_end_ = 0;
+  BlockSplit split_;
+  RCP<Matrix> block_matrix_;
+  RCP<MueLu::TpetraOperator<SC, LO, GO, NO>> block_amg_;
+  std::vector<std::int64_t> block_row_ptr_, block_cols_;
+  UmfpackFactor block_lu_;
   Eigen::MatrixXd modes_;
   Eigen::MatrixXd coordinates_;       // set_node_coordinates
   double requested_tolerance_ = 0.0;  // set_relative_tolerance

@@ -1,62 +1,16 @@
-// Sparse direct solver: SuiteSparse UMFPACK (Davis 2004, ACM TOMS 30(2)).
-// Why not Amesos2 KLU2: KLU orders for circuit matrices (BTF + COLAMD); on a
-// 3D finite-element matrix its fill explodes (Case 1 artery, 27,216 DOFs:
-// 60 s per factorization). UMFPACK detects the symmetric pattern and orders
-// A + A' with AMD (or METIS), which is what FE matrices need.
-//
-// The symbolic analysis depends on the pattern only, so it is kept while the
-// pattern stays the same (every Newton iteration of a solid scene) and only
-// the numeric factorization is redone.
-//
-// The CSR arrays are handed to UMFPACK as the compressed columns of A', which
-// it factorizes; solving with UMFPACK_At then gives A x = b.
-#include <umfpack.h>
-
+// Sparse direct solver ("direct" on one rank): one UMFPACK factorization per
+// solve (umfpack_factor.hpp; the symbolic analysis kept while the pattern stays).
+#include <algorithm>
 #include <chrono>
-#include <stdexcept>
-#include <string>
 
-#include "common/log.hpp"
 #include "solver/linalg/linear_solver.hpp"
+#include "solver/linalg/umfpack_factor.hpp"
 
 namespace stentsim::solver {
 namespace {
 
-static_assert(sizeof(SuiteSparse_long) == sizeof(std::int64_t), "UMFPACK's long index must be the CSR index type");
-
-std::string umfpack_status_text(SuiteSparse_long status) {
-  switch (status) {
-    case UMFPACK_WARNING_singular_matrix: return "the matrix is singular (a rigid-body motion not held, or an element with no stiffness?)";
-    case UMFPACK_ERROR_out_of_memory: return "out of memory";
-    case UMFPACK_ERROR_invalid_matrix: return "invalid matrix (unsorted or duplicate column indices)";
-    case UMFPACK_ERROR_different_pattern: return "the pattern changed since the symbolic analysis";
-    default: return "status " + std::to_string(status);
-  }
-}
-
-const char* strategy_name(double s) {
-  return s == UMFPACK_STRATEGY_SYMMETRIC ? "symmetric" : s == UMFPACK_STRATEGY_UNSYMMETRIC ? "unsymmetric" : "other";
-}
-const char* ordering_name(double o) {
-  if (o == UMFPACK_ORDERING_AMD) return "AMD";
-  if (o == UMFPACK_ORDERING_METIS) return "METIS";
-  if (o == UMFPACK_ORDERING_CHOLMOD) return "CHOLMOD";
-  if (o == UMFPACK_ORDERING_NONE) return "none";
-  return "other";
-}
-
 class UmfpackSolver : public LinearSolver {
  public:
-  UmfpackSolver() {
-    umfpack_dl_defaults(control_);
-    // Orders A + A' by AMD and METIS and keeps the one with less fill: the
-    // analysis is paid once per pattern.
-    control_[UMFPACK_ORDERING] = UMFPACK_ORDERING_BEST;
-  }
-  ~UmfpackSolver() override { release(); }
-  UmfpackSolver(const UmfpackSolver&) = delete;
-  UmfpackSolver& operator=(const UmfpackSolver&) = delete;
-
   LinearSolveStats solve(const CsrMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x) override {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
@@ -64,34 +18,9 @@ class UmfpackSolver : public LinearSolver {
       x.resize(0);
       return LinearSolveStats{1, 0.0, true};
     }
-    const SuiteSparse_long n = a.rows;
-    const auto* ap = reinterpret_cast<const SuiteSparse_long*>(a.row_ptr.data());
-    const auto* ai = reinterpret_cast<const SuiteSparse_long*>(a.cols.data());
-    if (!symbolic_ || a.row_ptr != row_ptr_ || a.cols != cols_) {
-      release();
-      const SuiteSparse_long st = umfpack_dl_symbolic(n, n, ap, ai, a.values.data(), &symbolic_, control_, info_);
-      if (st != UMFPACK_OK) {
-        symbolic_ = nullptr;
-        throw std::runtime_error("UMFPACK symbolic analysis failed: " + umfpack_status_text(st));
-      }
-      row_ptr_ = a.row_ptr;
-      cols_ = a.cols;
-      log::debug("UMFPACK analysis: n = {}, nnz(A) = {}, estimated nnz(L + U) = {:.0f}, {:.0f} MB ({} strategy, {} ordering), "
-                 "{:.2f} s", n, a.nonzeros(), info_[UMFPACK_LNZ_ESTIMATE] + info_[UMFPACK_UNZ_ESTIMATE],
-                 info_[UMFPACK_NUMERIC_SIZE_ESTIMATE] * info_[UMFPACK_SIZE_OF_UNIT] / 1e6,
-                 strategy_name(info_[UMFPACK_STRATEGY_USED]), ordering_name(info_[UMFPACK_ORDERING_USED]),
-                 std::chrono::duration<double>(Clock::now() - t0).count());
-    }
-    if (numeric_) umfpack_dl_free_numeric(&numeric_);
-    const SuiteSparse_long st = umfpack_dl_numeric(ap, ai, a.values.data(), symbolic_, &numeric_, control_, info_);
-    if (st != UMFPACK_OK) {
-      if (numeric_) umfpack_dl_free_numeric(&numeric_);
-      throw std::runtime_error("UMFPACK factorization failed: " + umfpack_status_text(st));
-    }
+    lu_.factor(a);
     const auto t1 = Clock::now();
-    x.resize(n);
-    const SuiteSparse_long ss = umfpack_dl_solve(UMFPACK_At, ap, ai, a.values.data(), x.data(), b.data(), numeric_, control_, info_);
-    if (ss != UMFPACK_OK) throw std::runtime_error("UMFPACK solve failed: " + umfpack_status_text(ss));
+    lu_.solve(b, x);
     const auto t2 = Clock::now();
     LinearSolveStats s;
     s.iterations = 1;
@@ -107,17 +36,7 @@ class UmfpackSolver : public LinearSolver {
   std::string describe() const override { return "UMFPACK sparse LU (direct)"; }
 
  private:
-  void release() {
-    if (numeric_) umfpack_dl_free_numeric(&numeric_);
-    if (symbolic_) umfpack_dl_free_symbolic(&symbolic_);
-    numeric_ = symbolic_ = nullptr;
-  }
-
-  double control_[UMFPACK_CONTROL]{};
-  double info_[UMFPACK_INFO]{};
-  void* symbolic_ = nullptr;
-  void* numeric_ = nullptr;
-  std::vector<std::int64_t> row_ptr_, cols_;  // the pattern symbolic_ was built for
+  UmfpackFactor lu_;
 };
 
 }  // namespace

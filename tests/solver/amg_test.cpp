@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <map>
 #include <filesystem>
 #include <unistd.h>
 #include <cstdio>
@@ -193,6 +194,38 @@ TEST(SolverAmg, ScenesChooseIt) {
     const std::string m = e.what();
     EXPECT_NE(m.find("stent_ring_expansion.yaml: solver.linear.type: gmres_amg"), std::string::npos) << m;
     EXPECT_NE(m.find("is a beam body"), std::string::npos) << m;
+  }
+  std::filesystem::remove_all(out);
+}
+
+// gmres_amg_block on a beam + solid contact scene (AMG on the balloon, LU on the
+// ring): the direct solver's QoIs, through contact coming in and out of reach (the
+// kept hierarchy meets newly filled contact entries there).
+TEST(SolverAmg, BlockPreconditionerOnBeamContactSceneMatchesDirect) {
+  const std::filesystem::path examples = std::filesystem::path(STENTSIM_TEST_SOURCE_DIR) / "examples";
+  const auto out = std::filesystem::temp_directory_path() / ("stentsim_amg_block_" + std::to_string(::getpid()));
+  std::map<std::string, double> q[2];
+  int k = 0;
+  for (const char* type : {"direct", "gmres_amg_block"}) {
+    SolveOptions o;
+    o.output_dir = out / type;
+    o.linear_solver = parse_linear_solver(type, "test");
+    ASSERT_EQ(solve_scene(examples / "contact_ring_on_balloon.yaml", o), 0) << type;
+    for (const char* name : {"D_max", "D_end", "recoil_percent", "contact_force_stent_balloon_max"})
+      q[k][name] = std::get<double>(Summary::read(out / type / "summary.yaml").qois().at(name).value);
+    ++k;
+  }
+  for (const auto& [name, v] : q[0]) EXPECT_NEAR(q[1][name], v, 1e-7 * std::abs(v)) << name;
+  EXPECT_GT(q[0]["contact_force_stent_balloon_max"], 1.0);  // the ring was pushed by contact
+  // A scene with one solid body and nothing else has no second block.
+  SolveOptions o;
+  o.output_dir = out / "tube";
+  o.linear_solver = LinearSolverType::gmres_amg_block;
+  try {
+    solve_scene(examples / "tube_inflation.yaml", o);
+    ADD_FAILURE() << "gmres_amg_block accepted a scene with one block";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no second block; use gmres_amg"), std::string::npos) << e.what();
   }
   std::filesystem::remove_all(out);
 }

@@ -143,7 +143,7 @@ TEST(SolverScene, BadInputNamesFileAndKey) {
   expect_error("neo_hooke: {E: 1 MPa, nu: 0.45}", "neo_hooke: {E: 1 MPa, nu: 0.45}\n        decoupled_hgo: {E: 1 MPa, nu: 0.45}",
                "decoupled_hgo: replaces the coupled neo-Hooke matrix: drop 'neo_hooke'");
   // MueLu parameters only for gmres_amg, and only from a file that exists.
-  expect_error("type: direct", "type: direct, amg_parameters: muelu.xml", "amg_parameters: applies to type: gmres_amg only");
+  expect_error("type: direct", "type: direct, amg_parameters: muelu.xml", "amg_parameters: applies to types gmres_amg and gmres_amg_block only");
   expect_error("type: direct", "type: gmres_amg, amg_parameters: muelu.xml", "amg_parameters: no such file");
   std::filesystem::remove_all(dir);
 }

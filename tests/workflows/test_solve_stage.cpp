@@ -156,9 +156,15 @@ TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs
   EXPECT_NE(w.find("240 of 240 endothelium faces"), std::string::npos) << w;
   EXPECT_NE(w.find("artery.vtu"), std::string::npos) << w;
 
-  // A patient case has no solve stage in this version.
+  // A patient scene: three layers (the intima as media), the warped balloon's frames from its own file, no
+  // straight-balloon profile.
   stentsim::files::write_atomic(dir / "p.yaml", "name: p\nscene: patient\ninput: {phantom: {preset: straight-healthy}}\n");
-  EXPECT_FALSE(stentsim::workflows::solve_stage_available(stentsim::workflows::load_case(dir / "p.yaml")));
+  const std::string p = stentsim::workflows::solve_scene_text(stentsim::workflows::load_case(dir / "p.yaml"));
+  EXPECT_NE(p.find("{tag: 1, preset: media}"), std::string::npos) << p;
+  EXPECT_NE(p.find("layers: {intima: 1, media: 2, adventitia: 3}"), std::string::npos) << p;
+  EXPECT_NE(p.find("{file: \"../balloon/balloon.vtu\", fibers: none}"), std::string::npos) << p;
+  EXPECT_EQ(p.find("balloon_profile"), std::string::npos) << p;
+  EXPECT_EQ(p.find("cylindrical"), std::string::npos) << p;
 }
 
 }  // namespace

@@ -1,0 +1,43 @@
+#pragma once
+// One SuiteSparse UMFPACK factorization (Davis 2004, ACM TOMS 30(2)) of a
+// CSR matrix, solved against many right-hand sides: the direct solver
+// (umfpack_solver.cpp) and the direct block of gmres_amg_block's
+// preconditioner (trilinos_solvers.cpp) share it.
+//
+// The symbolic analysis depends on the pattern only, so it is kept while the
+// pattern stays the same (every Newton iteration of a solid scene) and only
+// the numeric factorization is redone.
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+#include "solver/linalg/csr_matrix.hpp"
+
+namespace stentsim::solver {
+
+class UmfpackFactor {
+ public:
+  UmfpackFactor();
+  ~UmfpackFactor();
+  UmfpackFactor(const UmfpackFactor&) = delete;
+  UmfpackFactor& operator=(const UmfpackFactor&) = delete;
+
+  /// Factorizes `a` (kept by reference: it must outlive the solves). Throws
+  /// std::runtime_error naming UMFPACK's reason when it cannot.
+  void factor(const CsrMatrix& a);
+  /// x = A⁻¹ b with the last factorization.
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+  std::int64_t rows() const { return a_ ? a_->rows : 0; }
+
+ private:
+  void release();
+  const CsrMatrix* a_ = nullptr;
+  double control_[20]{};      // UMFPACK_CONTROL
+  mutable double info_[90]{};  // UMFPACK_INFO
+  void* symbolic_ = nullptr;
+  void* numeric_ = nullptr;
+  std::vector<std::int64_t> row_ptr_, cols_;  // the pattern symbolic_ was built for
+};
+
+}  // namespace stentsim::solver
