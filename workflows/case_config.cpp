@@ -99,8 +99,16 @@ SimulationSettings parse_simulation(ConfigMap m) {
   s.diastolic_pressure = m.quantity("diastolic_pressure", units::kPressure, s.diastolic_pressure, Range::between(0, 0.1));
   s.phase_duration = m.quantity("phase_duration", units::kTime, s.phase_duration, Range::positive());
   s.load_steps = m.integer("load_steps", s.load_steps, Range::between(1, 100000));
+  s.min_load_steps = m.integer("min_load_steps", s.min_load_steps, Range::between(0, 100000));
+  if (s.min_load_steps > s.load_steps)
+    m.fail("min_load_steps", fmt::format("must be at most load_steps ({}): the step grows from phase / load_steps up to "
+                                         "phase / min_load_steps (0: it never grows)", s.load_steps));
   s.linear_solver = solver::read_linear_solver(m, "linear_solver", s.linear_solver);
   s.ranks = m.integer("ranks", s.ranks, Range::between(1, 4096));
+  if (s.ranks > 1 && s.linear_solver == solver::LinearSolverType::gmres_amg_block)
+    m.fail("ranks", fmt::format("linear_solver gmres_amg_block runs on one MPI rank in this version; set ranks: 1, or "
+                                "linear_solver gmres_ilu (direct: the whole system's LU, far more memory) for {} ranks",
+                                s.ranks));
   s.balloon_end_springs = m.quantity("balloon_end_springs", units::kStiffnessPerArea, s.balloon_end_springs, Range::positive());
   s.cut_springs = m.quantity("cut_springs", units::kStiffnessPerArea, s.cut_springs, Range::positive());
   s.beam_penalty = m.quantity("beam_penalty", units::kPressure, s.beam_penalty, Range::positive());

@@ -40,6 +40,9 @@ struct SimulationSettings {
   double diastolic_pressure = 85 * 133.322387415e-6;  // MPa
   double phase_duration = 1.0;             // s of pseudo-time per phase
   int load_steps = 100;                    // per phase, initial
+  // per phase, the fewest: the step grows after easy steps up to the phase /
+  // min_load_steps (0: as load_steps, the step never grows)
+  int min_load_steps = 0;
   solver::LinearSolverType linear_solver = solver::LinearSolverType::direct;
   int ranks = 1;
   double balloon_end_springs = 100.0;      // N/mm^3

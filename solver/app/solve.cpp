@@ -94,11 +94,11 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     counters = state.counters;
     t_last = state.time;
     stepping.t_start = t_last;
-    stepping.dt_initial = state.next_dt;
+    stepping.dt_first = state.next_dt;
     stepping.first_step = counters.steps;
     stepping.last_increment = state.last_increment;
     stepping.last_dt = state.last_dt;
-    log::info("restart from {}: step {}, t = {:.6g}, next dt = {:.3g}", from.string(), counters.steps, t_last, stepping.dt_initial);
+    log::info("restart from {}: step {}, t = {:.6g}, next dt = {:.3g}", from.string(), counters.steps, t_last, stepping.dt_first);
   } else {
     frame(stepping.t_start);
   }

@@ -115,7 +115,7 @@ class BeamToSurfacePair : public Term {
   /// Where a point's projections put it: near a face (`face` ≥ 0, the inside projection of
   /// smallest |d| within reach), apart (inside a face but farther out than the reach), deep
   /// (inside a face but farther in than the reach), or nowhere (no projection inside a face;
-  /// `unconverged` counts the candidates whose local Newton did not converge).
+  /// `unconverged` counts the points left nowhere for which some candidate's local Newton did not converge).
   enum class Reach { near, apart, deep, nowhere };
   NormalProjection project(const ContactSurface& surface, const std::vector<int>& faces, const Vec3& p, int& face, Reach& reach,
                            int* unconverged = nullptr, const std::vector<Eigen::AlignedBox3d>* boxes = nullptr) const;
@@ -138,7 +138,7 @@ class BeamToSurfacePair : public Term {
   std::vector<std::vector<int>> reserved_;  // per element, the faces whose pattern was reserved (sorted)
   ActiveSet active_;  // per Gauss point (element-major)
   long long searches_ = 0;
-  int unconverged_ = 0;  // projections that did not converge in the last tangent assembly
+  int unconverged_ = 0;  // points left nowhere with a failed projection, in the last tangent assembly
   int rank_ = 0, ranks_ = 1;  // partition of the last assembly
 };
 

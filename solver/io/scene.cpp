@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -336,6 +337,21 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   }
   time.finish();
   for (const auto& c : scene.conditions) c->add_stops(scene, scene.stepping.stops);
+  // Load turns: the times inside the run where a load curve changes slope (held
+  // constant past its last point). Steps end on them and start small after them.
+  for (const auto& [name, curve] : scene.curves) {
+    const auto& pts = curve.points();
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double t = pts[i].first;
+      if (!(t > scene.stepping.t_start && t < scene.stepping.t_end)) continue;
+      const double before = i > 0 ? (pts[i].second - pts[i - 1].second) / (t - pts[i - 1].first) : 0.0;
+      const double after = i + 1 < pts.size() ? (pts[i + 1].second - pts[i].second) / (pts[i + 1].first - t) : 0.0;
+      if (std::abs(after - before) > 1e-12 * std::max(std::abs(after), std::abs(before))) {
+        scene.stepping.load_turns.push_back(t);
+        scene.stepping.stops.push_back(t);
+      }
+    }
+  }
   ConfigMap nw = s.map("newton");
   scene.newton.max_iterations = nw.integer("max_iterations", 20, Range::between(1, 1000));
   scene.newton.residual_tolerance = nw.number("residual_tolerance", 1e-8, Range::positive());

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "common/error.hpp"
+#include "common/log.hpp"
 #include "solver/linalg/block_split.hpp"
 #include "solver/linalg/linear_solver.hpp"
 #include "solver/linalg/umfpack_factor.hpp"
@@ -57,6 +58,53 @@ void ensure_initialized() {
   Tpetra::initialize(&argc, &argv);
   std::atexit([] { Tpetra::finalize(); });
 }
+
+// A fill-complete Tpetra matrix kept with the CSR pattern it was built from
+// (one rank). New values of the same pattern are written straight into its
+// local values through the position of each CSR entry there, found once:
+// replaceGlobalValues would look every column up in the column map's hash
+// table, which costs more than the assembly on a tet10 artery.
+struct KeptMatrix {
+  RCP<Matrix> matrix;
+  std::vector<std::int64_t> row_ptr, cols;
+  std::vector<std::size_t> slots;  // CSR entry k -> index into the local values
+
+  bool holds(const CsrMatrix& a) const { return matrix && a.row_ptr == row_ptr && a.cols == cols; }
+
+  void keep(RCP<Matrix> m, const CsrMatrix& a) {
+    matrix = std::move(m);
+    row_ptr = a.row_ptr;
+    cols = a.cols;
+    const auto local = matrix->getLocalMatrixHost();
+    const Map& colmap = *matrix->getColMap();
+    slots.assign(cols.size(), 0);
+    std::vector<std::pair<GO, std::size_t>> row;
+    for (std::int64_t i = 0; i < a.rows; ++i) {
+      const auto b = static_cast<std::size_t>(a.row_ptr[static_cast<std::size_t>(i)]);
+      const auto e = static_cast<std::size_t>(a.row_ptr[static_cast<std::size_t>(i) + 1]);
+      row.clear();
+      for (auto k = local.graph.row_map(i); k < local.graph.row_map(i + 1); ++k)
+        row.emplace_back(colmap.getGlobalElement(local.graph.entries(k)), static_cast<std::size_t>(k));
+      std::sort(row.begin(), row.end());
+      if (row.size() != e - b) throw std::logic_error("Tpetra matrix row " + std::to_string(i) + " differs from the CSR pattern");
+      for (std::size_t k = b; k < e; ++k) {
+        if (row[k - b].first != static_cast<GO>(a.cols[k]))
+          throw std::logic_error("Tpetra matrix row " + std::to_string(i) + " differs from the CSR pattern");
+        slots[k] = row[k - b].second;
+      }
+    }
+  }
+
+  /// New values of the kept pattern (holds(a) must be true).
+  void refill(const CsrMatrix& a) {
+    matrix->resumeFill();
+    {
+      const auto values = matrix->getLocalMatrixHost().values;
+      for (std::size_t k = 0; k < slots.size(); ++k) values(slots[k]) = a.values[k];
+    }
+    matrix->fillComplete();
+  }
+};
 
 // gmres_amg_block's preconditioner (block_split.hpp): one forward block
 // Gauss-Seidel sweep, AMG on block 1 then the direct solve of block 2 (one rank).
@@ -162,13 +210,13 @@ class TrilinosSolver : public LinearSolver {
     // gmres_amg_block keeps the whole matrix likewise, and its blocks' AMG and LU
     // while block 1's pattern stays (block_preconditioner).
     const bool keep = settings_.type != LinearSolverType::direct && comm_->getSize() == 1;
-    const bool reuse = keep && kept_matrix_ && a.row_ptr == kept_row_ptr_ && a.cols == kept_cols_;
+    const bool reuse = keep && kept_.holds(a);
     RCP<const Map> map;
     RCP<Matrix> mat;
     if (reuse) {
-      map = kept_matrix_->getRowMap();
-      mat = kept_matrix_;
-      refill(*mat, a);
+      map = kept_.matrix->getRowMap();
+      mat = kept_.matrix;
+      kept_.refill(a);
     } else {
       map = rcp(new Map(n, 0, comm_));
       mat = build_matrix(a, map);
@@ -190,23 +238,22 @@ class TrilinosSolver : public LinearSolver {
       RCP<OP> prec;
       if (block) {
         prec = block_preconditioner(a, map, stats);
-        if (!reuse) kept_matrix_ = mat, kept_row_ptr_ = a.row_ptr, kept_cols_ = a.cols;
+        if (!reuse) kept_.keep(mat, a);
       } else if (reuse) {
         if (auto ilu = Teuchos::rcp_dynamic_cast<Ifpack2::Preconditioner<SC, LO, GO, NO>>(kept_prec_)) {
           ilu->compute();
         } else {
           auto amg = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(kept_prec_, true);
-          MueLu::ReuseTpetraPreconditioner(mat, *amg);
-          stats.amg_levels = amg->GetHierarchy()->GetNumLevels();
+          if (!reuse_amg(mat, *amg)) kept_prec_ = make_preconditioner(mat, map, stats, true);
+          stats.amg_levels = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(kept_prec_, true)
+                                 ->GetHierarchy()->GetNumLevels();
         }
         prec = kept_prec_;
       } else {
         prec = make_preconditioner(mat, map, stats, keep);
         if (keep) {
           kept_prec_ = prec;
-          kept_matrix_ = mat;
-          kept_row_ptr_ = a.row_ptr;
-          kept_cols_ = a.cols;
+          kept_.keep(mat, a);
         }
       }
       const auto t1 = Clock::now();
@@ -271,21 +318,6 @@ class TrilinosSolver : public LinearSolver {
     return m;
   }
 
-  // New values into a fill-complete matrix of the same pattern.
-  static void refill(Matrix& m, const CsrMatrix& a) {
-    m.resumeFill();
-    Teuchos::Array<GO> cols;
-    for (std::int64_t i = 0; i < a.rows; ++i) {
-      const auto b = a.row_ptr[static_cast<std::size_t>(i)], e = a.row_ptr[static_cast<std::size_t>(i) + 1];
-      if (b == e) continue;
-      cols.resize(static_cast<std::size_t>(e - b));
-      for (auto k = b; k < e; ++k) cols[static_cast<std::size_t>(k - b)] = static_cast<GO>(a.cols[static_cast<std::size_t>(k)]);
-      const LO replaced = m.replaceGlobalValues(static_cast<GO>(i), cols(), Teuchos::ArrayView<const SC>(&a.values[static_cast<std::size_t>(b)], e - b));
-      if (replaced != static_cast<LO>(e - b)) throw std::logic_error("ILU reuse: the matrix pattern differs from the one factorized");
-    }
-    m.fillComplete();
-  }
-
   LinearSolveStats gathered_direct_solve(const RCP<Matrix>& mat, const RCP<const Map>& map, const Eigen::VectorXd& b,
                                          Eigen::VectorXd& x) const {
     const GO n = static_cast<GO>(map->getGlobalNumElements());
@@ -338,34 +370,38 @@ class TrilinosSolver : public LinearSolver {
     if (block_end_ <= block_begin_)
       throw std::logic_error("gmres_amg_block: no AMG block was set (set_amg_block)");
     split_ = split_blocks(a, block_begin_, block_end_);
-    bool same = block_amg_ && split_.a11.row_ptr == block_row_ptr_ && split_.a11.cols == block_cols_;
+    bool same = block_amg_ && block_.holds(split_.a11);
     if (same) {
-      refill(*block_matrix_, split_.a11);
-      // Contact terms reserve entries that stay exactly zero until a point comes
-      // within reach; the kept coarse operators' static graphs miss the products
-      // of such entries once they fill (Tpetra: "insert a new entry into a static
-      // graph"). The hierarchy is then built afresh for the new values.
-      try {
-        MueLu::ReuseTpetraPreconditioner(block_matrix_, *block_amg_);
-      } catch (const std::exception& e) {
-        std::string what = e.what();
-        if (settings_.verbosity > 0)
-          std::fprintf(stderr, "gmres_amg_block: the kept AMG hierarchy does not take the new values (%s); building it afresh\n",
-                       what.substr(0, what.find('\n', what.find_first_not_of('\n'))).c_str());
-        same = false;
-      }
+      block_.refill(split_.a11);
+      same = reuse_amg(block_.matrix, *block_amg_);
     }
     if (!same) {
       RCP<const Map> map1 = rcp(new Map(static_cast<GO>(split_.a11.rows), 0, comm_));
-      block_matrix_ = build_matrix(split_.a11, map1);
+      RCP<Matrix> m = build_matrix(split_.a11, map1);
       block_amg_ = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(
-          make_preconditioner(block_matrix_, map1, stats, true), true);
-      block_row_ptr_ = split_.a11.row_ptr;
-      block_cols_ = split_.a11.cols;
+          make_preconditioner(m, map1, stats, true), true);
+      block_.keep(m, split_.a11);
     }
     stats.amg_levels = block_amg_->GetHierarchy()->GetNumLevels();
     block_lu_.factor(split_.a22);
-    return rcp(new BlockGaussSeidel(map, block_matrix_->getRowMap(), block_amg_, split_, block_lu_));
+    return rcp(new BlockGaussSeidel(map, block_.matrix->getRowMap(), block_amg_, split_, block_lu_));
+  }
+
+  // The kept hierarchy's prolongators with the new values (MueLu reuse RP).
+  // Contact terms reserve entries that stay exactly zero until a point comes
+  // within reach; the kept coarse operators' static graphs miss the products of
+  // such entries once they fill (Tpetra: "insert a new entry into a static
+  // graph"). False then: the caller builds the hierarchy afresh.
+  bool reuse_amg(const RCP<Matrix>& m, MueLu::TpetraOperator<SC, LO, GO, NO>& amg) const {
+    try {
+      MueLu::ReuseTpetraPreconditioner(m, amg);
+      return true;
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      if (what.find("static graph") == std::string::npos) throw;
+      log::debug("AMG: the kept hierarchy does not take the new values (newly filled entries); building it afresh");
+      return false;
+    }
   }
 
   // SA-AMG needs a near-null space that describes every row with the fixed
@@ -478,16 +514,14 @@ class TrilinosSolver : public LinearSolver {
   std::unique_ptr<LinearSolver> direct_ = make_umfpack_solver();
   // gmres_ilu and gmres_amg on one rank: the matrix and the preconditioner (RILUK, or
   // the MueLu hierarchy with its prolongators) kept while the pattern stays.
-  RCP<Matrix> kept_matrix_;
+  KeptMatrix kept_;
   RCP<OP> kept_prec_;
-  std::vector<std::int64_t> kept_row_ptr_, kept_cols_;
   // gmres_amg_block: block 1's range, the split, its AMG (with its matrix and pattern) and block 2's LU.
   std::int64_t block_begin_ = 0, block_end_ = 0;
   BlockSplit split_;
-  RCP<Matrix> block_matrix_;
+  KeptMatrix block_;
   RCP<MueLu::TpetraOperator<SC, LO, GO, NO>> block_amg_;
-  std::vector<std::int64_t> block_row_ptr_, block_cols_;
-  UmfpackFactor block_lu_;
+  UmfpackFactor block_lu_{false};  // no iterative refinement: GMRES corrects the block solve
   Eigen::MatrixXd modes_;
   Eigen::MatrixXd coordinates_;       // set_node_coordinates
   double requested_tolerance_ = 0.0;  // set_relative_tolerance

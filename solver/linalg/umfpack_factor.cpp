@@ -44,8 +44,9 @@ const char* ordering_name(double o) {
 
 static_assert(UMFPACK_CONTROL == 20 && UMFPACK_INFO == 90, "umfpack_factor.hpp sizes its arrays by UMFPACK's");
 
-UmfpackFactor::UmfpackFactor() {
+UmfpackFactor::UmfpackFactor(bool refine) {
   umfpack_dl_defaults(control_);
+  if (!refine) control_[UMFPACK_IRSTEP] = 0;
   // Orders A + A' by AMD and METIS and keeps the one with less fill: the
   // analysis is paid once per pattern.
   control_[UMFPACK_ORDERING] = UMFPACK_ORDERING_BEST;

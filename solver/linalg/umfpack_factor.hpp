@@ -18,7 +18,11 @@ namespace stentsim::solver {
 
 class UmfpackFactor {
  public:
-  UmfpackFactor();
+  /// `refine`: UMFPACK's iterative refinement after each solve (its default, up
+  /// to two steps, each a residual and a further solve). A preconditioner's
+  /// block solve needs no refinement: GMRES corrects it, and refinement would
+  /// triple the block's share of every Krylov iteration.
+  explicit UmfpackFactor(bool refine = true);
   ~UmfpackFactor();
   UmfpackFactor(const UmfpackFactor&) = delete;
   UmfpackFactor& operator=(const UmfpackFactor&) = delete;

@@ -18,7 +18,7 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
   stops.push_back(s.t_end);
   std::sort(stops.begin(), stops.end());
   const double eps = 1e-12 * std::max(1.0, std::abs(s.t_end));
-  double t = s.t_start, dt = std::min(s.dt_initial, s.dt_max);
+  double t = s.t_start, dt = std::min(s.dt_first > 0.0 ? s.dt_first : s.dt_initial, s.dt_max);
   int step = s.first_step;
   int cuts_since_easy = 0;  // the stall counter: cuts since the last easy step
   Eigen::VectorXd last_increment = s.last_increment;
@@ -61,6 +61,8 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
           dt = std::min(dt * s.grow_factor, s.dt_max);
           cuts_since_easy = 0;
         }
+        if (std::any_of(s.load_turns.begin(), s.load_turns.end(), [&](double turn) { return std::abs(t - turn) <= eps; }))
+          dt = std::min(dt, s.dt_initial);
         break;
       }
       model.rollback();

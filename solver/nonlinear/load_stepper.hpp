@@ -2,7 +2,8 @@
 // Adaptive load stepping in pseudo-time: a step that fails (no convergence,
 // too many iterations, an element that cannot be evaluated) is rolled back
 // and cut; easy steps let the step grow. Steps end exactly on `stops` (phase
-// ends, output times).
+// ends, output times); the step after one that ends on a load turn (a time
+// where a load curve changes slope) starts again from dt_initial.
 //
 // Predictor (NewtonSettings::predictor): each attempt starts from the last
 // converged step's increment scaled by h / h_last, a secant extrapolation of
@@ -37,6 +38,11 @@ struct StepperSettings {
   double cut_factor = 0.5, grow_factor = 1.5;
   int easy_iterations = 5;     // grow after a step with at most this many Newton iterations
   std::vector<double> stops;   // times a step must end on
+  // Stops where a load curve changes slope: the next load may act quite
+  // differently (the balloon's inflation after the artery's prestress), so the
+  // step grown on the last one starts again from dt_initial.
+  std::vector<double> load_turns;
+  double dt_first = 0.0;       // the first step's size (a restart's next dt); 0: dt_initial
   int first_step = 0;          // steps done before t_start (restart: numbering continues)
   /// The predictor's start (restart): the last converged step's increment and size.
   Eigen::VectorXd last_increment;

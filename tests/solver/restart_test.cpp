@@ -87,6 +87,8 @@ void check_restart(const std::string& example, const std::string& body, int ever
   // The last frame's displacements agree to 1e-10 (mm).
   const int frames = static_cast<int>(std::get<double>(a.qois().at("steps").value));
   const std::string last = "results/" + body + "_" + fmt::format("{:05d}", frames) + ".vtu";
+  // The checkpoint lies before the end: the resumed run took steps and wrote the last frame itself.
+  ASSERT_TRUE(std::filesystem::exists(dir / "resumed" / last)) << "the resumed run took no step: its checkpoint is the end";
   const double d = max_difference(read_vtu((dir / "full" / last).string()), read_vtu((dir / "resumed" / last).string()),
                                   "Displacement");
   // A restart that ignored the checkpoint and ran from t = 0 would pass every comparison above: the resumed run

@@ -93,6 +93,58 @@ TEST(SolverRobustness, InvertedTrialStateLeadsToACutAndTheSameAnswer) {
   EXPECT_LT((big - small).norm(), 1e-8 * small.norm());
 }
 
+// Easy steps grow the step (x1.5 up to dt_max); a step ends exactly on each
+// stop, and after a load turn (not after another stop) the next one starts from
+// dt_initial again: a new load phase may be hard.
+TEST(SolverRobustness, StepGrowsOnEasyStepsAndStartsAgainAfterALoadTurn) {
+  LinearSolverSettings ls;
+  ls.type = LinearSolverType::eigen_lu;
+  auto b = make_block(0.1);
+  GlobalSystem sys(b->model.constraints);
+  auto linear = make_linear_solver(ls);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
+  StepperSettings st;
+  st.dt_initial = 0.1;
+  st.dt_max = 0.3;
+  st.stops = {0.5, 0.8};
+  st.load_turns = {0.5};
+  std::vector<double> times, dts;
+  run_load_steps(b->model, sys, *linear, u, st, no_line_search(), [&](const StepRecord& r) {
+    times.push_back(r.time);
+    dts.push_back(r.dt);
+  });
+  auto after = [&](double stop) {
+    std::size_t i = 0;
+    while (i < times.size() && std::abs(times[i] - stop) > 1e-12) ++i;
+    EXPECT_LT(i + 1, times.size()) << "no step ended on t = " << stop;
+    return i + 1 < times.size() ? dts[i + 1] : 0.0;
+  };
+  // 0.1, 0.15, 0.225 reach 0.475; a step of 0.025 ends on the load turn.
+  ASSERT_GE(times.size(), 5u);
+  EXPECT_NEAR(dts[0], 0.1, 1e-12);
+  EXPECT_NEAR(dts[1], 0.15, 1e-12);
+  EXPECT_NEAR(dts[2], 0.225, 1e-12);
+  EXPECT_NEAR(after(0.5), 0.1, 1e-12) << "the step after the load turn starts from dt_initial";
+  EXPECT_GT(after(0.8), 0.1 + 1e-9) << "a stop that is no load turn keeps the grown step";
+  EXPECT_NEAR(times.back(), 1.0, 1e-12);
+  // A restart's first step (dt_first) is not the scene's dt_initial.
+  StepperSettings rs = st;
+  rs.t_start = 0.2;
+  rs.dt_first = 0.2;
+  auto b2 = make_block(0.1);
+  GlobalSystem sys2(b2->model.constraints);
+  Eigen::VectorXd u2 = Eigen::VectorXd::Zero(b2->model.dofs.size());
+  std::vector<double> rt, rdt;
+  run_load_steps(b2->model, sys2, *linear, u2, rs, no_line_search(), [&](const StepRecord& r) {
+    rt.push_back(r.time);
+    rdt.push_back(r.dt);
+  });
+  ASSERT_GE(rdt.size(), 3u);
+  EXPECT_NEAR(rdt[0], 0.2, 1e-12);
+  for (std::size_t i = 0; i + 1 < rt.size(); ++i)
+    if (std::abs(rt[i] - 0.5) < 1e-12) EXPECT_NEAR(rdt[i + 1], 0.1, 1e-12) << "after the load turn: dt_initial, not dt_first";
+}
+
 TEST(SolverRobustness, FailureAtTheMinimumStepStopsWithTheElementAndTheLastState) {
   auto b = make_block(kPressure);
   GlobalSystem sys(b->model.constraints);

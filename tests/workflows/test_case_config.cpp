@@ -45,7 +45,14 @@ TEST(CaseConfig, EveryExampleLoadsAndValidates) {
   const auto c = load_case(dir / "patient.yaml");
   EXPECT_NEAR(c.simulation.diastolic_pressure, 85 * 133.322387415e-6, 1e-15);
   EXPECT_DOUBLE_EQ(c.simulation.pressure_max, 1.01);
-  EXPECT_DOUBLE_EQ(c.mesh.size, 0.25);
+  EXPECT_DOUBLE_EQ(c.mesh.size, 0.8);
+  EXPECT_EQ(c.simulation.load_steps, 10);
+  EXPECT_EQ(c.simulation.min_load_steps, 2);
+  // The paper's resolution ships as an example of its own.
+  const auto paper = load_case(fs::path(STENTSIM_TEST_SOURCE_DIR) / "examples/patient-paper.yaml");
+  EXPECT_EQ(paper.scene, Scene::patient);
+  EXPECT_DOUBLE_EQ(paper.mesh.size, 0.25);
+  EXPECT_EQ(paper.simulation.load_steps, 100);
   fs::remove_all(dir);
 }
 
@@ -60,6 +67,14 @@ TEST(CaseConfig, BadFilesGiveErrorsThatNameFileLineKeyAndExpectation) {
   msg = load_error("scene: patient\nsimulation:\n  pressure_max: 13 mm\n");
   EXPECT_NE(msg.find("simulation.pressure_max"), std::string::npos) << msg;
   EXPECT_NE(msg.find("expected a pressure"), std::string::npos) << msg;
+  const std::string in = "input: {phantom: {preset: case2-rca}}\n";
+  msg = load_error("scene: patient\n" + in + "simulation:\n  linear_solver: gmres_amg_block\n  ranks: 2\n");
+  EXPECT_NE(msg.find("bad.yaml:5:10: simulation.ranks"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("gmres_amg_block runs on one MPI rank"), std::string::npos) << msg;
+  EXPECT_EQ(load_error("scene: patient\n" + in + "simulation:\n  linear_solver: gmres_ilu\n  ranks: 2\n"), "");
+  msg = load_error("scene: patient\nsimulation:\n  load_steps: 4\n  min_load_steps: 5\n");
+  EXPECT_NE(msg.find("simulation.min_load_steps"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("at most load_steps (4)"), std::string::npos) << msg;
   msg = load_error("scene: patient\nsimulation:\n  load_steps: 0\n");
   EXPECT_NE(msg.find("out of range"), std::string::npos) << msg;
   msg = load_error("scene: patient\nsimulation:\n  load_steps: many\n");

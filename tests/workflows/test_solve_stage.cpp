@@ -132,6 +132,11 @@ TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs
   ASSERT_EQ(scene.bodies.size(), 3u);
   EXPECT_EQ(scene.bodies[2].name, "artery");
   EXPECT_EQ(scene.stepping.t_end, 3.0);  // prestress, inflation, deflation
+  // load_steps 4 and no min_load_steps: the step starts at and never grows beyond a quarter phase.
+  EXPECT_DOUBLE_EQ(scene.stepping.dt_initial, 0.25);
+  EXPECT_DOUBLE_EQ(scene.stepping.dt_max, 0.25);
+  // Above the beams' round-off floor (~5e-10 N).
+  EXPECT_DOUBLE_EQ(scene.newton.residual_absolute, 1e-8);
   ASSERT_EQ(scene.contacts.size(), 3u);
   EXPECT_EQ(scene.contacts[1]->name, "stent_artery");
   EXPECT_EQ(scene.contacts[2]->name, "balloon_artery");
@@ -165,6 +170,20 @@ TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs
   EXPECT_NE(p.find("{file: \"../balloon/balloon.vtu\", fibers: none}"), std::string::npos) << p;
   EXPECT_EQ(p.find("balloon_profile"), std::string::npos) << p;
   EXPECT_EQ(p.find("cylindrical"), std::string::npos) << p;
+
+  // min_load_steps lets the step grow to phase / min_load_steps; more than load_steps is refused.
+  stentsim::files::write_atomic(dir / "p2.yaml", "name: p\nscene: patient\ninput: {phantom: {preset: straight-healthy}}\n"
+                                                 "simulation: {load_steps: 20, min_load_steps: 4}\n");
+  const std::string grown = stentsim::workflows::solve_scene_text(stentsim::workflows::load_case(dir / "p2.yaml"));
+  EXPECT_NE(grown.find("dt: 0.050000000000000003, dt_max: 0.25,"), std::string::npos) << grown;
+  stentsim::files::write_atomic(dir / "p3.yaml", "name: p\nscene: patient\ninput: {phantom: {preset: straight-healthy}}\n"
+                                                 "simulation: {load_steps: 4, min_load_steps: 5}\n");
+  try {
+    stentsim::workflows::load_case(dir / "p3.yaml");
+    ADD_FAILURE() << "min_load_steps above load_steps was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("min_load_steps"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
