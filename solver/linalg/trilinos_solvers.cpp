@@ -60,39 +60,33 @@ void ensure_initialized() {
 }
 
 // A fill-complete Tpetra matrix kept with the CSR pattern it was built from
-// (one rank). New values of the same pattern are written straight into its
-// local values through the position of each CSR entry there, found once:
-// replaceGlobalValues would look every column up in the column map's hash
-// table, which costs more than the assembly on a tet10 artery.
+// (one rank). On one rank the column map is the row map, in order, so the
+// matrix's packed local values lie in the CSR's own order: new values of the
+// same pattern are copied straight in (replaceGlobalValues would look every
+// column up in the column map's hash table, which costs more than the assembly
+// on a tet10 artery). keep() checks that order once; where it does not hold,
+// the matrix is not kept and each solve builds its own.
 struct KeptMatrix {
   RCP<Matrix> matrix;
   std::vector<std::int64_t> row_ptr, cols;
-  std::vector<std::size_t> slots;  // CSR entry k -> index into the local values
 
   bool holds(const CsrMatrix& a) const { return matrix && a.row_ptr == row_ptr && a.cols == cols; }
 
   void keep(RCP<Matrix> m, const CsrMatrix& a) {
+    matrix = Teuchos::null;
+    const auto local = m->getLocalMatrixHost();
+    const Map& colmap = *m->getColMap();
+    if (static_cast<std::int64_t>(local.numRows()) != a.rows) return;
+    for (std::int64_t i = 0; i < a.rows; ++i) {
+      const auto b = a.row_ptr[static_cast<std::size_t>(i)], e = a.row_ptr[static_cast<std::size_t>(i) + 1];
+      if (static_cast<std::int64_t>(local.graph.row_map(i)) != b || static_cast<std::int64_t>(local.graph.row_map(i + 1)) != e)
+        return;
+      for (auto k = b; k < e; ++k)
+        if (colmap.getGlobalElement(local.graph.entries(k)) != static_cast<GO>(a.cols[static_cast<std::size_t>(k)])) return;
+    }
     matrix = std::move(m);
     row_ptr = a.row_ptr;
     cols = a.cols;
-    const auto local = matrix->getLocalMatrixHost();
-    const Map& colmap = *matrix->getColMap();
-    slots.assign(cols.size(), 0);
-    std::vector<std::pair<GO, std::size_t>> row;
-    for (std::int64_t i = 0; i < a.rows; ++i) {
-      const auto b = static_cast<std::size_t>(a.row_ptr[static_cast<std::size_t>(i)]);
-      const auto e = static_cast<std::size_t>(a.row_ptr[static_cast<std::size_t>(i) + 1]);
-      row.clear();
-      for (auto k = local.graph.row_map(i); k < local.graph.row_map(i + 1); ++k)
-        row.emplace_back(colmap.getGlobalElement(local.graph.entries(k)), static_cast<std::size_t>(k));
-      std::sort(row.begin(), row.end());
-      if (row.size() != e - b) throw std::logic_error("Tpetra matrix row " + std::to_string(i) + " differs from the CSR pattern");
-      for (std::size_t k = b; k < e; ++k) {
-        if (row[k - b].first != static_cast<GO>(a.cols[k]))
-          throw std::logic_error("Tpetra matrix row " + std::to_string(i) + " differs from the CSR pattern");
-        slots[k] = row[k - b].second;
-      }
-    }
   }
 
   /// New values of the kept pattern (holds(a) must be true).
@@ -100,7 +94,7 @@ struct KeptMatrix {
     matrix->resumeFill();
     {
       const auto values = matrix->getLocalMatrixHost().values;
-      for (std::size_t k = 0; k < slots.size(); ++k) values(slots[k]) = a.values[k];
+      for (std::size_t k = 0; k < a.values.size(); ++k) values(k) = a.values[k];
     }
     matrix->fillComplete();
   }
@@ -371,12 +365,14 @@ class TrilinosSolver : public LinearSolver {
       throw std::logic_error("gmres_amg_block: no AMG block was set (set_amg_block)");
     split_ = split_blocks(a, block_begin_, block_end_);
     bool same = block_amg_ && block_.holds(split_.a11);
+    RCP<const Map> map1;
     if (same) {
       block_.refill(split_.a11);
       same = reuse_amg(block_.matrix, *block_amg_);
+      map1 = block_.matrix->getRowMap();
     }
     if (!same) {
-      RCP<const Map> map1 = rcp(new Map(static_cast<GO>(split_.a11.rows), 0, comm_));
+      map1 = rcp(new Map(static_cast<GO>(split_.a11.rows), 0, comm_));
       RCP<Matrix> m = build_matrix(split_.a11, map1);
       block_amg_ = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(
           make_preconditioner(m, map1, stats, true), true);
@@ -384,7 +380,7 @@ class TrilinosSolver : public LinearSolver {
     }
     stats.amg_levels = block_amg_->GetHierarchy()->GetNumLevels();
     block_lu_.factor(split_.a22);
-    return rcp(new BlockGaussSeidel(map, block_.matrix->getRowMap(), block_amg_, split_, block_lu_));
+    return rcp(new BlockGaussSeidel(map, map1, block_amg_, split_, block_lu_));
   }
 
   // The kept hierarchy's prolongators with the new values (MueLu reuse RP).
