@@ -50,6 +50,15 @@ CsrMatrix grid_matrix(int n, double skew, bool extra_coupling = false, double wx
   return a;
 }
 
+// Scalar AMG (constant near-null space) solved to 1e-10, for the grid matrices.
+LinearSolverSettings scalar_amg(LinearSolverType type) {
+  LinearSolverSettings s;
+  s.type = type;
+  s.amg_equations_per_node = 1;
+  s.tolerance = 1e-10;
+  return s;
+}
+
 Eigen::VectorXd eigen_lu_solution(const CsrMatrix& a, const Eigen::VectorXd& b) {
   Eigen::VectorXd x;
   make_eigen_lu_solver()->solve(a, b, x);
@@ -148,10 +157,7 @@ TEST(IluReuse, RefilledMatrixAndRecomputedIluMatchAFreshSolver) {
 // stay as accurate and about as short as a fresh hierarchy's; a grown pattern
 // builds a fresh one (the same iteration count as a fresh solver).
 TEST(AmgReuse, KeptProlongatorsSolveNewValuesAndANewPatternRebuilds) {
-  LinearSolverSettings s;
-  s.type = LinearSolverType::gmres_amg;
-  s.amg_equations_per_node = 1;
-  s.tolerance = 1e-10;
+  const LinearSolverSettings s = scalar_amg(LinearSolverType::gmres_amg);
   const auto kept = make_linear_solver(s);
   Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3375, -1, 2);
   int reused_differently = 0;
@@ -186,10 +192,7 @@ TEST(AmgReuse, KeptProlongatorsSolveNewValuesAndANewPatternRebuilds) {
 // more GMRES iterations than a fresh solver; the full matrix left with them
 // would give a wrong solution.
 TEST(AmgBlockReuse, RefilledBlocksSolveNewValuesAsAFreshSolver) {
-  LinearSolverSettings s;
-  s.type = LinearSolverType::gmres_amg_block;
-  s.amg_equations_per_node = 1;
-  s.tolerance = 1e-10;
+  const LinearSolverSettings s = scalar_amg(LinearSolverType::gmres_amg_block);
   const auto kept = make_linear_solver(s);
   kept->set_amg_block(0, 3000);
   Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3375, -1, 2);
