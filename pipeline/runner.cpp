@@ -208,6 +208,9 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       rec.outputs = hash_outputs(plan_, r.stage);
       manifest.set(s.name, rec);
       manifest.save(manifest_file());
+      std::error_code ec;
+      fs::remove_all(resume_dir(plan_.work_dir(), s.name), ec);  // done: nothing left to resume
+      fs::remove(plan_.work_dir() / ".resume", ec);               // only if empty
       done.insert(r.stage);
       report.ran.push_back(s.name);
       out << fmt::format("  done  {:<13} {:.2f} s, {:.0f} MB\n", s.name, dt, o.peak_memory_mb);

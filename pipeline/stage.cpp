@@ -22,6 +22,14 @@ fs::path StageContext::input(const std::string& declared) const {
   return p.is_absolute() ? p : work_dir_ / p;
 }
 
+fs::path resume_dir(const fs::path& work_dir, const std::string& name) { return work_dir / ".resume" / name; }
+
+fs::path StageContext::resume_dir() const {
+  const fs::path d = pipeline::resume_dir(work_dir_, stage_.name);
+  fs::create_directories(d);
+  return d;
+}
+
 fs::path StageContext::temp_path(const std::string& declared) const { return temp_dir_ / fs::path(declared); }
 
 fs::path StageContext::output(const std::string& declared) const {

@@ -43,6 +43,10 @@ class StageContext {
   /// The stage's summary.yaml content; the engine adds wall time and memory.
   Summary& summary() { return summary_; }
 
+  /// A folder that outlives a failed or interrupted attempt of this stage (work/.resume/<stage>/,
+  /// created here): what a long stage needs to continue where the last attempt stopped. The
+  /// engine removes it once the stage has succeeded.
+  std::filesystem::path resume_dir() const;
   /// Temporary location of an output (engine use).
   std::filesystem::path temp_path(const std::string& declared) const;
 
@@ -52,6 +56,8 @@ class StageContext {
   Summary summary_;
 };
 
+/// The resume folder of stage `name` in `work_dir` (StageContext::resume_dir).
+std::filesystem::path resume_dir(const std::filesystem::path& work_dir, const std::string& name);
 /// Path of the summary every stage writes, relative to the work folder.
 std::string summary_output(const std::string& stage_name);
 

@@ -120,6 +120,7 @@ SimulationSettings parse_simulation(ConfigMap m) {
 OutputSettings parse_output(ConfigMap m) {
   OutputSettings s;
   s.every = m.integer("every", s.every, Range::between(1, 1000000));
+  s.checkpoint_every = m.integer("checkpoint_every", s.checkpoint_every, Range::between(0, 1000000));
   m.finish();
   return s;
 }

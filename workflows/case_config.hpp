@@ -53,6 +53,9 @@ struct SimulationSettings {
 
 struct OutputSettings {
   int every = 1;  // write results every N converged steps
+  // a solve checkpoint every N converged steps (0: none), from which the solve stage
+  // resumes an interrupted or failed attempt
+  int checkpoint_every = 1;
 };
 
 struct CaseConfig {

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <optional>
 #include <limits>
 #include <fstream>
 #include <sstream>
@@ -15,6 +17,7 @@
 #include "common/mesh_tags.hpp"
 #include "device_gen/stent_design.hpp"
 #include "pipeline/child_process.hpp"
+#include "solver/app/checkpoint.hpp"
 #include "solver/app/solve.hpp"
 #include "solver/io/scene.hpp"
 #include "solver/linalg/linear_solver.hpp"
@@ -194,9 +197,11 @@ std::string solver_section(const CaseConfig& c, const Phases& ph) {
       "  # device in prestress stalls Newton at that floor.\n"
       "  newton: {{max_iterations: 25, residual_tolerance: 1.0e-8, residual_absolute: 1.0e-8, increment_tolerance: 1.0e-8}}\n"
       "  linear: {{type: {lin}}}\n\n"
-      "output:\n  every: {every}\n\n",
+      "output:\n  every: {every}\n"
+      "  checkpoint_every: {ck}          # the stage resumes an interrupted or failed attempt from it\n\n",
       fmt::arg("end", ph.after()), fmt::arg("dt", dt), fmt::arg("dtmax", dt_max), fmt::arg("dtmin", dt * 1e-4),
-      fmt::arg("lin", solver::linear_solver_name(c.simulation.linear_solver)), fmt::arg("every", c.output.every));
+      fmt::arg("lin", solver::linear_solver_name(c.simulation.linear_solver)), fmt::arg("every", c.output.every),
+      fmt::arg("ck", c.output.checkpoint_every));
 }
 
 std::string qois(const CaseConfig& c, const Phases& ph) {
@@ -276,6 +281,63 @@ std::vector<std::string> mpi_launcher(int ranks) {
   return {"mpirun", "--allow-run-as-root", "--oversubscribe", "-np", std::to_string(ranks)};
 }
 
+/// Where the solve runs and what it resumes from. The solve writes into the stage's resume
+/// folder, with a checkpoint every output.checkpoint_every steps, so that an attempt that was
+/// interrupted (Ctrl-C, a killed job) or failed continues from its last checkpoint when the
+/// stage runs again. A checkpoint that cannot resume this scene (its bodies, conditions,
+/// contact, input files or loads up to its time differ) is dropped with what it was written
+/// by, and the run starts over in an emptied folder.
+struct SolveRun {
+  fs::path dir;
+  std::optional<fs::path> restart;
+};
+
+SolveRun prepare_solve_run(const solver::SceneDesc& scene, const fs::path& resume_dir) {
+  SolveRun run{resume_dir, std::nullopt};
+  const fs::path checkpoint = resume_dir / "checkpoint.bin";
+  const std::string refusal = fs::exists(checkpoint) ? solver::checkpoint_refusal(scene, checkpoint) : "none";
+  if (refusal.empty()) {
+    log::info("resuming the solve from the checkpoint of an earlier attempt: {}", checkpoint.string());
+    run.restart = checkpoint;
+    return run;
+  }
+  if (refusal != "none") log::info("not resuming from {}: {}; the solve starts from the beginning", checkpoint.string(), refusal);
+  for (const auto& entry : fs::directory_iterator(resume_dir)) fs::remove_all(entry.path());
+  return run;
+}
+
+/// A second name `to` for the file `from`: a hard link (a copy where the file system has
+/// none). The results writer replaces files, never changes them in place, so both names
+/// keep the content of the moment.
+void link_or_copy(const fs::path& from, const fs::path& to) {
+  std::error_code ec;
+  fs::remove(to, ec);
+  fs::create_hard_link(from, to, ec);
+  if (!ec) return;
+  fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
+  if (ec) throw ComputeError(fmt::format("cannot copy {} to {}: {}", from.string(), to.string(), ec.message()));
+}
+
+/// The solve's outputs into the stage's output folder: moved when it finished (the resume
+/// folder is then removed by the runner), hard-linked when it did not, so that failed/solve/
+/// holds them while the resume folder keeps its checkpoint and frames for the next attempt.
+void hand_over_results(const fs::path& from, const fs::path& to, bool finished) {
+  for (const char* name : {"results.pvd", "history.csv", "results"}) {
+    const fs::path src = from / name, dst = to / name;
+    if (!fs::exists(src)) continue;
+    if (finished) {
+      fs::rename(src, dst);
+      continue;
+    }
+    if (!fs::is_directory(src)) {
+      link_or_copy(src, dst);
+      continue;
+    }
+    fs::create_directories(dst);
+    for (const auto& entry : fs::directory_iterator(src)) link_or_copy(entry.path(), dst / entry.path().filename());
+  }
+}
+
 }  // namespace
 
 std::string contact_face_size_warning(const fs::path& artery_vtu, double strut_diameter) {
@@ -330,32 +392,47 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
     const std::string face_warning =
         cfg.scene == Scene::free_expansion ? "" : contact_face_size_warning(ctx.input("mesh/artery.vtu"), strut_diameter);
     if (!face_warning.empty()) ctx.summary().note("warning_contact_face_size", face_warning);
-    if (cfg.simulation.ranks <= 1) {
-      const solver::SceneDesc scene = solver::read_scene(text, final_scene);
-      solver::SolveOptions o;
-      o.output_dir = out_dir;
-      if (solver::solve(scene, o, ctx.summary()) != 0)
-        throw ComputeError(fmt::format("the solve did not finish (the log says where and why); its last converged state, "
-                                       "history.csv and summary are kept in {}",
-                                       (ctx.work_dir() / "failed" / "solve" / "solve").string()));
-      return;
-    }
     // MPI: a copy of the scene with absolute paths, run by `stentsim solve` under mpirun.
     const fs::path run_scene = out_dir.parent_path() / "run_scene.yaml";
-    files::write_atomic(run_scene, scene_text(cfg, artifacts(cfg, ctx.work_dir())));
-    std::vector<std::string> argv = mpi_launcher(cfg.simulation.ranks);
-    for (const std::string& a : {pipeline::self_executable().string(), std::string("solve"), run_scene.string(),
-                                std::string("--out"), out_dir.string()})
-      argv.push_back(a);
-    const auto start = std::chrono::steady_clock::now();
-    const pid_t pid = pipeline::spawn_exec(argv);
-    const pipeline::ChildEnd end = pipeline::wait_with_limit(pid, start, 1e9);
-    if (!end.ok())
+    const bool mpi = cfg.simulation.ranks > 1;
+    if (mpi) files::write_atomic(run_scene, scene_text(cfg, artifacts(cfg, ctx.work_dir())));
+    const solver::SceneDesc scene = mpi ? solver::read_scene(run_scene) : solver::read_scene(text, final_scene);
+    const SolveRun run = prepare_solve_run(scene, ctx.resume_dir());
+    int status = 0;
+    std::string mpi_end;
+    if (!mpi) {
+      solver::SolveOptions o;
+      o.output_dir = run.dir;
+      o.restart = run.restart;
+      status = solver::solve(scene, o, ctx.summary());
+    } else {
+      std::vector<std::string> argv = mpi_launcher(cfg.simulation.ranks);
+      for (const std::string& a : {pipeline::self_executable().string(), std::string("solve"), run_scene.string(),
+                                  std::string("--out"), run.dir.string()})
+        argv.push_back(a);
+      if (run.restart) argv.insert(argv.end(), {"--restart", run.restart->string()});
+      const auto start = std::chrono::steady_clock::now();
+      const pid_t pid = pipeline::spawn_exec(argv);
+      const pipeline::ChildEnd end = pipeline::wait_with_limit(pid, start, 1e9);
+      if (!end.ok()) status = 1, mpi_end = end.describe();
+      else ctx.summary() = Summary::read(run.dir / "summary.yaml");
+      if (!face_warning.empty()) ctx.summary().note("warning_contact_face_size", face_warning);
+    }
+    hand_over_results(run.dir, out_dir, status == 0);
+    if (status == 0) return;
+    const std::string kept = (ctx.work_dir() / "failed" / "solve" / "solve").string();
+    const std::string resume = fs::exists(run.dir / "checkpoint.bin")
+                                   ? fmt::format("; `stentsim run` continues from its last checkpoint ({}) unless the "
+                                                 "bodies, conditions, contact or loads change",
+                                                 (run.dir / "checkpoint.bin").string())
+                                   : std::string();
+    if (mpi)
       throw ComputeError(fmt::format("the MPI solve ({} ranks) ended with {} (the log says where and why); what it wrote "
-                                     "is kept in {}",
-                                     cfg.simulation.ranks, end.describe(), (ctx.work_dir() / "failed" / "solve").string()));
-    ctx.summary() = Summary::read(out_dir / "summary.yaml");
-    if (!face_warning.empty()) ctx.summary().note("warning_contact_face_size", face_warning);
+                                     "is kept in {}{}",
+                                     cfg.simulation.ranks, mpi_end, kept, resume));
+    throw ComputeError(fmt::format("the solve did not finish (the log says where and why); its last converged state, "
+                                   "history.csv and summary are kept in {}{}",
+                                   kept, resume));
   };
   return s;
 }

@@ -71,8 +71,9 @@ void put_fingerprint(HistoryArchive& out, const std::map<std::string, std::strin
   for (const auto& [part, hash] : parts) out.put_text("solver/state/" + part, hash);
 }
 
-void check_fingerprint(const HistoryArchive& in, const std::map<std::string, std::string>& parts,
-                       const std::string& checkpoint, const std::string& scene) {
+namespace {
+// The parts that differ between a checkpoint's fingerprint and `parts`, or empty.
+std::string fingerprint_difference(const HistoryArchive& in, const std::map<std::string, std::string>& parts) {
   std::string differ;
   for (const auto& [part, hash] : parts) {
     const std::string key = "solver/state/" + part;
@@ -81,9 +82,28 @@ void check_fingerprint(const HistoryArchive& in, const std::map<std::string, std
   }
   for (const std::string& key : in.text_keys("solver/state/"))
     if (!parts.count(key.substr(13))) differ += fmt::format("{}{} (not in the scene)", differ.empty() ? "" : ", ", key.substr(13));
+  return differ;
+}
+}  // namespace
+
+void check_fingerprint(const HistoryArchive& in, const std::map<std::string, std::string>& parts,
+                       const std::string& checkpoint, const std::string& scene) {
+  const std::string differ = fingerprint_difference(in, parts);
   if (!differ.empty())
     throw InputError(fmt::format("{}: the checkpoint was written by another scene than {} (what differs: {}); a checkpoint "
                                  "resumes only the run that wrote it: run without --restart", checkpoint, scene, differ));
+}
+
+std::string checkpoint_refusal(const SceneDesc& scene, const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file)) return "there is no checkpoint";
+  try {
+    const HistoryArchive ck = HistoryArchive::read(file);
+    const std::string differ =
+        fingerprint_difference(ck, state_fingerprint(scene, scene_state_hashes(scene), ck.get_scalar("solver/time")));
+    return differ.empty() ? std::string() : fmt::format("it was written by another scene (what differs: {})", differ);
+  } catch (const std::exception& e) {
+    return fmt::format("it cannot be read ({})", e.what());
+  }
 }
 
 }  // namespace stentsim::solver

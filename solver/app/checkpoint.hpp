@@ -5,6 +5,7 @@
 // observers add their parts under their own prefixes.
 #include <Eigen/Core>
 
+#include <filesystem>
 #include <map>
 #include <string>
 
@@ -49,5 +50,9 @@ void put_fingerprint(HistoryArchive& out, const std::map<std::string, std::strin
 /// checkpoint lacks) when the checkpoint was written by another scene.
 void check_fingerprint(const HistoryArchive& in, const std::map<std::string, std::string>& parts,
                        const std::string& checkpoint, const std::string& scene);
+
+/// Why `file` cannot resume a run of `scene` (missing, unreadable or damaged, written by
+/// another scene); empty when it can.
+std::string checkpoint_refusal(const SceneDesc& scene, const std::filesystem::path& file);
 
 }  // namespace stentsim::solver

@@ -137,7 +137,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
       model.save_history(ck);
       writer.save(ck);
       ck.write(checkpoint_file);
-      log::info("checkpoint at step {} (t = {:.6g}): {}", r.step, r.time, checkpoint_file.string());
+      log::debug("checkpoint at step {} (t = {:.6g}): {}", r.step, r.time, checkpoint_file.string());
     }
   };
   // The stall message names the load the run could not go beyond ("no converged state beyond p = ...").

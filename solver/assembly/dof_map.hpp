@@ -24,12 +24,13 @@ class DofMap {
       if (dof >= r.first && dof < r.first + r.count) return r.owner;
     return "?";
   }
-
- private:
   struct Range {
     std::string owner;
     GlobalDof first, count;
   };
+  const std::vector<Range>& ranges() const { return ranges_; }
+
+ private:
   std::vector<Range> ranges_;
   GlobalDof size_ = 0;
 };

@@ -9,6 +9,7 @@
 // is itself inadmissible (the pair throws there), so the line search backs off
 // from a full step that would chatter.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "solver/contact/owned_flags.hpp"
@@ -30,13 +31,21 @@ class ActiveSet {
     evaluated_[i] = active;
     return changes_[i] + (static_cast<bool>(iterate_[i]) != active ? 1 : 0);
   }
-  /// Term::accept: the evaluated state is the new iterate.
-  void accept() {
+  struct Changes {
+    int active = 0, entered = 0, left = 0;  // this rank's points
+  };
+  /// Term::accept: the evaluated state is the new iterate; what changed from the last one.
+  Changes accept() {
+    Changes c;
     for (std::size_t i = 0; i < iterate_.size(); ++i) {
-      if (iterate_[i] != evaluated_[i]) ++changes_[i];
+      if (iterate_[i] != evaluated_[i]) ++changes_[i], ++(evaluated_[i] ? c.entered : c.left);
       iterate_[i] = evaluated_[i];
+      c.active += iterate_[i] != 0;
     }
+    return c;
   }
+  /// A debug line when the accepted iterate's active set changed.
+  static void log_changes(std::string_view pair, const Changes& c);
   void begin_step() { std::fill(changes_.begin(), changes_.end(), 0); }
   /// Term::commit: the last tangent assembly's state converged (in Newton it is also the
   /// accepted iterate). Every rank evaluated its own items only (`per_item` points each).

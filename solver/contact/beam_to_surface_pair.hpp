@@ -87,7 +87,7 @@ class BeamToSurfacePair : public Term {
   /// Every rank evaluated its own elements only: the flags are gathered so that every rank
   /// (and rank 0's checkpoint) holds all of them.
   void commit() override;
-  void accept() override { active_.accept(); }
+  void accept() override { ActiveSet::log_changes(name_, active_.accept()); }
   void rollback() override { active_.rollback(); }
   /// The active flags of the last converged state (the projection-failure rule needs them).
   bool has_history() const override { return true; }

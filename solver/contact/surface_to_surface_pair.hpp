@@ -100,7 +100,7 @@ class SurfaceToSurfacePair : public Term {
   void begin_step(const SystemState& state) override;
   void assemble(const SystemState& state, Assembler& out) override;
   void commit() override;
-  void accept() override { active_.accept(); }
+  void accept() override { ActiveSet::log_changes(name_, active_.accept()); }
   void rollback() override { active_.rollback(); }
   /// The nodal active flags of the last converged state (the chattering count starts from them).
   bool has_history() const override { return true; }

@@ -48,6 +48,16 @@ void ResultsWriter::load(const HistoryArchive& in) {
   frames_ = static_cast<int>(in.get_scalar("results/frames"));
   last_time_ = in.get_scalar("results/last_time");
   files::write_atomic(dir_ / "history.csv", history_);
+  // Frames the interrupted run wrote after its checkpoint are in no PVD entry now: remove them,
+  // the resumed run writes its own.
+  for (const auto& entry : std::filesystem::directory_iterator(dir_ / "results")) {
+    const std::string name = entry.path().filename().string();
+    const std::size_t end = name.size() >= 4 ? name.size() - 4 : 0, begin = name.rfind('_', end);
+    if (begin == std::string::npos || name.compare(end, 4, ".vtu") != 0 || end - begin != 6) continue;
+    const std::string digits = name.substr(begin + 1, 5);
+    if (digits.find_first_not_of("0123456789") == std::string::npos && std::stoi(digits) >= frames_)
+      std::filesystem::remove(entry.path());
+  }
 }
 
 }  // namespace stentsim::solver

@@ -21,6 +21,25 @@ double reaction_norm(const Constraints& c, const Eigen::VectorXd& r) {
     if (c.fixed(d)) s += r(d) * r(d);
   return std::sqrt(s);
 }
+
+// The free residual per DOF owner (body, condition) and the DOF where it is largest: which
+// part of a coupled model holds Newton back.
+std::string residual_by_owner(const Model& model, const Eigen::VectorXd& r) {
+  std::string out;
+  double worst = -1.0;
+  GlobalDof worst_dof = 0;
+  for (const auto& range : model.dofs.ranges()) {
+    double s = 0.0;
+    for (GlobalDof d = range.first; d < range.first + range.count; ++d) {
+      if (model.constraints.fixed(d)) continue;
+      s += r(d) * r(d);
+      if (std::abs(r(d)) > worst) worst = std::abs(r(d)), worst_dof = d;
+    }
+    out += fmt::format("{}{} {:.2e}", out.empty() ? "" : ", ", range.owner, std::sqrt(s));
+  }
+  if (worst >= 0.0) out += fmt::format("; largest {:.2e} at DOF {} ({})", worst, worst_dof, model.dofs.owner_of(worst_dof));
+  return out;
+}
 }  // namespace
 
 NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linear, Eigen::VectorXd& u, double time,
@@ -215,6 +234,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
                eta > 0.0 ? fmt::format(" to {:.1e}", eta) : std::string(),
                ls.amg_levels > 0 ? fmt::format(" (AMG levels {})", ls.amg_levels) : std::string(), ls.setup_seconds,
                ls.solve_seconds);
+    if (model.dofs.ranges().size() > 1) log::debug("    |R| by part: {}", residual_by_owner(model, system.residual()));
     // Round-off floor: an increment at machine precision cannot improve the state
     // further (tiny loads on stiff models leave |R| just above an absolute tolerance).
     // Only after a linear solve that converged: a failed Krylov solve can return

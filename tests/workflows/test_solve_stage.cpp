@@ -2,12 +2,17 @@
 // scene it writes (only what the scene needs; re-runnable by hand with
 // `stentsim solve`), the quantities it reports and what makes it stale.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 #include "common/files.hpp"
 #include "common/mesh_data.hpp"
@@ -184,6 +189,76 @@ TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("min_load_steps"), std::string::npos) << e.what();
   }
+}
+
+// Rows of a CSV file after its header.
+std::size_t data_rows(const fs::path& csv) {
+  const std::string text = stentsim::files::read_text(csv);
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) - 1;
+}
+
+TEST_F(SolveStage, AnInterruptedSolveContinuesFromItsLastCheckpoint) {
+  const std::string fe = "name: fe-small\nscene: free-expansion\ndevice: {balloon: {length: 3 mm}, stent: {rings: 1}}\n";
+  stentsim::files::write_atomic(dir / "ref/fe.yaml", fe + "simulation: {pressure_max: 0.6 MPa, load_steps: 10}\n");
+  stentsim::files::write_atomic(dir / "fe.yaml", fe + "simulation: {pressure_max: 0.6 MPa, load_steps: 10}\n");
+  auto r = run_stentsim("run " + (dir / "ref/fe.yaml").string() + " --until solve");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path ref = dir / "ref/fe.work/solve";
+  EXPECT_FALSE(fs::exists(dir / "ref/fe.work/.resume")) << "a finished solve leaves nothing to resume";
+
+  // The same case, stopped (Ctrl-C) once its solve has written a checkpoint after a few steps.
+  const fs::path work = dir / "fe.work", resume = work / ".resume/solve";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::setpgid(0, 0);
+    const std::string file = (dir / "fe.yaml").string();
+    ::execl(STENTSIM_TEST_BINARY, STENTSIM_TEST_BINARY, "run", file.c_str(), "--until", "solve", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  bool checkpointed = false;
+  for (int i = 0; i < 6000 && !checkpointed; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    checkpointed = fs::exists(resume / "checkpoint.bin") && fs::exists(resume / "history.csv") && data_rows(resume / "history.csv") >= 3;
+  }
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(checkpointed) << "no checkpoint after three steps";
+  const std::size_t done_before = data_rows(resume / "history.csv");
+  ASSERT_LT(done_before, data_rows(ref / "history.csv")) << "the solve finished before it was stopped";
+  EXPECT_FALSE(fs::exists(work / "solve/results.pvd"));
+  EXPECT_TRUE(fs::exists(resume / "checkpoint.bin"));
+  fs::copy_file(resume / "checkpoint.bin", dir / "saved_checkpoint.bin");
+
+  // Run again: the solve resumes (not from step 0) and ends where the uninterrupted run did.
+  r = run_stentsim("run " + (dir / "fe.yaml").string() + " --until solve");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string log = stentsim::files::read_text(work / "logs/solve.log");
+  EXPECT_NE(log.find("resuming the solve from the checkpoint of an earlier attempt"), std::string::npos) << log;
+  EXPECT_NE(log.find("restart from"), std::string::npos) << log;
+  for (const char* q : {"stent_diameter_max", "stent_diameter_after", "recoil_percent"})
+    EXPECT_NEAR(qoi(work / "solve/summary.yaml", q), qoi(ref / "summary.yaml", q), 1e-9) << q;
+  EXPECT_EQ(qoi(work / "solve/summary.yaml", "steps"), qoi(ref / "summary.yaml", "steps"));
+  EXPECT_EQ(data_rows(work / "solve/history.csv"), data_rows(ref / "history.csv"));
+  EXPECT_EQ(stentsim::files::read_text(work / "solve/results.pvd"), stentsim::files::read_text(ref / "results.pvd"));
+  std::size_t frames = 0, ref_frames = 0;
+  for (const auto& e : fs::directory_iterator(work / "solve/results")) frames += e.is_regular_file();
+  for (const auto& e : fs::directory_iterator(ref / "results")) ref_frames += e.is_regular_file();
+  EXPECT_EQ(frames, ref_frames);
+  EXPECT_FALSE(fs::exists(work / ".resume")) << "a finished solve leaves nothing to resume";
+
+  // A checkpoint of another scene (here the pressure changed) is not resumed: the log says why.
+  fs::create_directories(resume);
+  fs::copy_file(dir / "saved_checkpoint.bin", resume / "checkpoint.bin");
+  stentsim::files::write_atomic(dir / "fe.yaml", fe + "simulation: {pressure_max: 0.5 MPa, load_steps: 10}\n");
+  r = run_stentsim("run " + (dir / "fe.yaml").string() + " --until solve");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string log2 = stentsim::files::read_text(work / "logs/solve.log");
+  EXPECT_NE(log2.find("not resuming from"), std::string::npos) << log2;
+  EXPECT_NE(log2.find("written by another scene"), std::string::npos) << log2;
+  EXPECT_LT(qoi(work / "solve/summary.yaml", "stent_diameter_max"), qoi(ref / "summary.yaml", "stent_diameter_max"));
+  EXPECT_EQ(log2.find("restart from", log2.find("not resuming from")), std::string::npos) << "it resumed: " << log2;
 }
 
 }  // namespace
