@@ -36,4 +36,40 @@ BlockSplit split_blocks(const CsrMatrix& a, std::int64_t begin, std::int64_t end
   return s;
 }
 
+CsrMatrix amg_matrix(const CsrMatrix& a11) {
+  CsrMatrix m;
+  m.rows = a11.rows;
+  m.row_ptr.reserve(a11.row_ptr.size());
+  for (std::int64_t i = 0; i < a11.rows; ++i) {
+    for (auto k = a11.row_ptr[static_cast<std::size_t>(i)]; k < a11.row_ptr[static_cast<std::size_t>(i) + 1]; ++k) {
+      const double v = a11.values[static_cast<std::size_t>(k)];
+      const std::int64_t j = a11.cols[static_cast<std::size_t>(k)];
+      if (v != 0.0 || j == i) m.cols.push_back(j), m.values.push_back(v);
+    }
+    m.row_ptr.push_back(m.nonzeros());
+  }
+  return m;
+}
+
+bool amg_matrix_on(const CsrMatrix& a11, const std::vector<std::int64_t>& row_ptr, const std::vector<std::int64_t>& cols,
+                   CsrMatrix& out) {
+  if (row_ptr.size() != a11.row_ptr.size()) return false;
+  out.rows = a11.rows;
+  out.row_ptr = row_ptr;
+  out.cols = cols;
+  out.values.resize(cols.size());
+  for (std::int64_t i = 0; i < a11.rows; ++i) {
+    auto k = a11.row_ptr[static_cast<std::size_t>(i)];
+    const auto k_end = a11.row_ptr[static_cast<std::size_t>(i) + 1];
+    // Both rows are sorted by column: one merge.
+    for (auto p = row_ptr[static_cast<std::size_t>(i)]; p < row_ptr[static_cast<std::size_t>(i) + 1]; ++p) {
+      const std::int64_t j = cols[static_cast<std::size_t>(p)];
+      while (k < k_end && a11.cols[static_cast<std::size_t>(k)] < j) ++k;
+      if (k == k_end || a11.cols[static_cast<std::size_t>(k)] != j) return false;
+      out.values[static_cast<std::size_t>(p)] = a11.values[static_cast<std::size_t>(k)];
+    }
+  }
+  return true;
+}
+
 }  // namespace stentsim::solver

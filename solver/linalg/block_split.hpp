@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <vector>
 
 #include "solver/linalg/csr_matrix.hpp"
 
@@ -29,5 +30,17 @@ struct BlockSplit {
 /// Splits `a` (one rank: the whole matrix). Throws std::invalid_argument when
 /// the range is empty or leaves no block 2.
 BlockSplit split_blocks(const CsrMatrix& a, std::int64_t begin, std::int64_t end);
+
+/// The matrix block 1's AMG is built from: A11 without its exact zeros (diagonal kept).
+/// Contact pairs reserve entries that stay zero until a point comes within reach; an AMG
+/// hierarchy built with them empty cannot take their values later (the coarse operators'
+/// graphs lack their products), so the preconditioner's A11 keeps the pattern it was built
+/// on: the entries that fill later (contact couplings of surface nodes that share no
+/// element) act through GMRES's operator, not through the V-cycle.
+CsrMatrix amg_matrix(const CsrMatrix& a11);
+/// A11's values at the positions of an earlier amg_matrix's pattern (row_ptr, cols). False
+/// when that pattern has a position `a11` lacks (another model); `out` is then undefined.
+bool amg_matrix_on(const CsrMatrix& a11, const std::vector<std::int64_t>& row_ptr, const std::vector<std::int64_t>& cols,
+                   CsrMatrix& out);
 
 }  // namespace stentsim::solver

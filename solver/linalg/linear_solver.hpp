@@ -52,6 +52,8 @@ struct LinearSolveStats {
   /// gmres_amg: levels of the MueLu hierarchy built for this solve (1 = the
   /// system was at or below the coarse size and was not coarsened); 0 otherwise.
   int amg_levels = 0;
+  /// A preconditioner (AMG hierarchy, ILU factors) was built afresh for this solve, not kept.
+  bool preconditioner_built = false;
 };
 
 class LinearSolver {

@@ -364,19 +364,22 @@ class TrilinosSolver : public LinearSolver {
     if (block_end_ <= block_begin_)
       throw std::logic_error("gmres_amg_block: no AMG block was set (set_amg_block)");
     split_ = split_blocks(a, block_begin_, block_end_);
-    bool same = block_amg_ && block_.holds(split_.a11);
+    // The AMG's A11 keeps the pattern its hierarchy was built on (amg_matrix, block_split.hpp).
+    CsrMatrix m11;
+    bool same = block_amg_ && block_.matrix && amg_matrix_on(split_.a11, block_.row_ptr, block_.cols, m11) && block_.holds(m11);
     RCP<const Map> map1;
     if (same) {
-      block_.refill(split_.a11);
+      block_.refill(m11);
       same = reuse_amg(block_.matrix, *block_amg_);
       map1 = block_.matrix->getRowMap();
     }
     if (!same) {
-      map1 = rcp(new Map(static_cast<GO>(split_.a11.rows), 0, comm_));
-      RCP<Matrix> m = build_matrix(split_.a11, map1);
+      m11 = amg_matrix(split_.a11);
+      map1 = rcp(new Map(static_cast<GO>(m11.rows), 0, comm_));
+      RCP<Matrix> m = build_matrix(m11, map1);
       block_amg_ = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(
           make_preconditioner(m, map1, stats, true), true);
-      block_.keep(m, split_.a11);
+      block_.keep(m, m11);
     }
     stats.amg_levels = block_amg_->GetHierarchy()->GetNumLevels();
     block_lu_.factor(split_.a22);
@@ -420,6 +423,7 @@ class TrilinosSolver : public LinearSolver {
 
   // `reusable`: AMG keeps its prolongators for ReuseTpetraPreconditioner.
   RCP<OP> make_preconditioner(const RCP<Matrix>& mat, const RCP<const Map>& map, LinearSolveStats& stats, bool reusable) const {
+    stats.preconditioner_built = true;
     if (settings_.type == LinearSolverType::gmres_ilu) {
       using RowMatrix = Tpetra::RowMatrix<SC, LO, GO, NO>;
       Teuchos::ParameterList p;

@@ -232,7 +232,9 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}{}, set-up {:.2f} s, "
                "solve {:.2f} s", it, r_norm, scale, du_norm, best_alpha, ls.iterations,
                eta > 0.0 ? fmt::format(" to {:.1e}", eta) : std::string(),
-               ls.amg_levels > 0 ? fmt::format(" (AMG levels {})", ls.amg_levels) : std::string(), ls.setup_seconds,
+               ls.amg_levels > 0 ? fmt::format(" (AMG levels {}{})", ls.amg_levels, ls.preconditioner_built ? ", built" : "")
+                                 : std::string(),
+               ls.setup_seconds,
                ls.solve_seconds);
     if (model.dofs.ranges().size() > 1) log::debug("    |R| by part: {}", residual_by_owner(model, system.residual()));
     // Round-off floor: an increment at machine precision cannot improve the state

@@ -211,3 +211,50 @@ TEST(AmgBlockReuse, RefilledBlocksSolveNewValuesAsAFreshSolver) {
     EXPECT_LE(st_kept.iterations, 1.5 * st_fresh.iterations + 1) << "skew " << c.skew;
   }
 }
+
+// Contact pairs reserve entries that stay exactly zero until a point comes within
+// reach. gmres_amg_block builds block 1's AMG without them and keeps that pattern
+// (block_split.hpp, amg_matrix), so when they fill the hierarchy is reused, not
+// rebuilt, and GMRES (whose operator has them) still solves to the tolerance in
+// about as many iterations as a fresh solver.
+TEST(AmgBlockReuse, ReservedEntriesThatFillKeepTheHierarchy) {
+  const LinearSolverSettings s = scalar_amg(LinearSolverType::gmres_amg_block);
+  const auto kept = make_linear_solver(s);
+  kept->set_amg_block(0, 3000);
+  Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3375, -1, 2);
+  // The long-range coupling inside block 1: (0, 2999) and (2999, 0), reserved as zeros first.
+  auto with_coupling = [](double skew, double v) {
+    CsrMatrix a = grid_matrix(15, skew);
+    CsrMatrix c;
+    c.rows = a.rows;
+    c.row_ptr = {0};
+    for (std::int64_t i = 0; i < a.rows; ++i) {
+      std::vector<std::pair<std::int64_t, double>> row;
+      for (auto k = a.row_ptr[i]; k < a.row_ptr[i + 1]; ++k) row.emplace_back(a.cols[k], a.values[k]);
+      if (i == 0) row.emplace_back(2999, v);
+      if (i == 2999) row.emplace_back(0, -0.5 * v);
+      std::sort(row.begin(), row.end());
+      for (const auto& [col, val] : row) c.cols.push_back(col), c.values.push_back(val);
+      c.row_ptr.push_back(static_cast<std::int64_t>(c.cols.size()));
+    }
+    return c;
+  };
+  int built = 0;
+  for (const auto& [skew, v] : std::vector<std::pair<double, double>>{{0.0, 0.0}, {0.2, 0.0}, {0.3, 2.0}, {-0.4, 3.0}}) {
+    const CsrMatrix a = with_coupling(skew, v);
+    const auto fresh = make_linear_solver(s);
+    fresh->set_amg_block(0, 3000);
+    Eigen::VectorXd x_kept, x_fresh;
+    const auto st_kept = kept->solve(a, b, x_kept);
+    const auto st_fresh = fresh->solve(a, b, x_fresh);
+    ASSERT_TRUE(st_kept.converged && st_fresh.converged) << "skew " << skew;
+    std::printf("block, reserved coupling %.1f: kept %d, fresh %d GMRES iterations%s\n", v, st_kept.iterations,
+                st_fresh.iterations, st_kept.preconditioner_built ? " (built)" : "");
+    EXPECT_TRUE(st_fresh.preconditioner_built);
+    built += st_kept.preconditioner_built ? 1 : 0;
+    EXPECT_LT((a.multiply(x_kept) - b).norm() / b.norm(), 1e-9) << "skew " << skew;
+    EXPECT_LT((x_kept - x_fresh).norm() / x_fresh.norm(), 1e-8) << "skew " << skew;
+    EXPECT_LE(st_kept.iterations, 1.5 * st_fresh.iterations + 2) << "skew " << skew;
+  }
+  EXPECT_EQ(built, 1) << "the hierarchy of the first solve serves the filled couplings too";
+}
