@@ -260,7 +260,12 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       const Stage& s = stages[i];
       ++counter;
       auto reasons = stale_reasons(plan_, i, manifest);
-      if (options.force_all || options.force.count(s.name)) reasons.insert(reasons.begin(), "forced");
+      if (options.force_all || options.force.count(s.name)) {
+        reasons.insert(reasons.begin(), "forced");
+        // Forced: from the beginning, not from what an earlier attempt left to resume.
+        std::error_code ec;
+        if (!options.dry_run) fs::remove_all(resume_dir(plan_.work_dir(), s.name), ec);
+      }
       if (reasons.empty()) {
         done.insert(i);
         report.skipped.push_back(s.name);

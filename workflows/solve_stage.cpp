@@ -197,11 +197,9 @@ std::string solver_section(const CaseConfig& c, const Phases& ph) {
       "  # device in prestress stalls Newton at that floor.\n"
       "  newton: {{max_iterations: 25, residual_tolerance: 1.0e-8, residual_absolute: 1.0e-8, increment_tolerance: 1.0e-8}}\n"
       "  linear: {{type: {lin}}}\n\n"
-      "output:\n  every: {every}\n"
-      "  checkpoint_every: {ck}          # the stage resumes an interrupted or failed attempt from it\n\n",
+      "output:\n  every: {every}\n\n",
       fmt::arg("end", ph.after()), fmt::arg("dt", dt), fmt::arg("dtmax", dt_max), fmt::arg("dtmin", dt * 1e-4),
-      fmt::arg("lin", solver::linear_solver_name(c.simulation.linear_solver)), fmt::arg("every", c.output.every),
-      fmt::arg("ck", c.output.checkpoint_every));
+      fmt::arg("lin", solver::linear_solver_name(c.simulation.linear_solver)), fmt::arg("every", c.output.every));
 }
 
 std::string qois(const CaseConfig& c, const Phases& ph) {
@@ -285,24 +283,32 @@ std::vector<std::string> mpi_launcher(int ranks) {
 /// folder, with a checkpoint every output.checkpoint_every steps, so that an attempt that was
 /// interrupted (Ctrl-C, a killed job) or failed continues from its last checkpoint when the
 /// stage runs again. A checkpoint that cannot resume this scene (its bodies, conditions,
-/// contact, input files or loads up to its time differ) is dropped with what it was written
-/// by, and the run starts over in an emptied folder.
+/// contact, input files or loads up to its time differ, or it cannot be read) is dropped
+/// with the reason in the log, and the run starts over in an emptied folder; so is one found
+/// with checkpoints switched off (checkpoint_every 0).
 struct SolveRun {
   fs::path dir;
   std::optional<fs::path> restart;
 };
 
-SolveRun prepare_solve_run(const solver::SceneDesc& scene, const fs::path& resume_dir) {
+void empty_folder(const fs::path& dir) {
+  for (const auto& entry : fs::directory_iterator(dir)) fs::remove_all(entry.path());
+}
+
+SolveRun prepare_solve_run(const solver::SceneDesc& scene, const fs::path& resume_dir, int checkpoint_every) {
   SolveRun run{resume_dir, std::nullopt};
   const fs::path checkpoint = resume_dir / "checkpoint.bin";
-  const std::string refusal = fs::exists(checkpoint) ? solver::checkpoint_refusal(scene, checkpoint) : "none";
-  if (refusal.empty()) {
-    log::info("resuming the solve from the checkpoint of an earlier attempt: {}", checkpoint.string());
-    run.restart = checkpoint;
-    return run;
+  if (fs::exists(checkpoint)) {
+    const std::string refusal = checkpoint_every > 0 ? solver::checkpoint_refusal(scene, checkpoint)
+                                                     : std::string("output.checkpoint_every is 0");
+    if (refusal.empty()) {
+      log::info("resuming the solve from the checkpoint of an earlier attempt: {}", checkpoint.string());
+      run.restart = checkpoint;
+      return run;
+    }
+    log::info("not resuming from {}: {}; the solve starts from the beginning", checkpoint.string(), refusal);
   }
-  if (refusal != "none") log::info("not resuming from {}: {}; the solve starts from the beginning", checkpoint.string(), refusal);
-  for (const auto& entry : fs::directory_iterator(resume_dir)) fs::remove_all(entry.path());
+  empty_folder(resume_dir);
   return run;
 }
 
@@ -318,15 +324,17 @@ void link_or_copy(const fs::path& from, const fs::path& to) {
   if (ec) throw ComputeError(fmt::format("cannot copy {} to {}: {}", from.string(), to.string(), ec.message()));
 }
 
-/// The solve's outputs into the stage's output folder: moved when it finished (the resume
-/// folder is then removed by the runner), hard-linked when it did not, so that failed/solve/
-/// holds them while the resume folder keeps its checkpoint and frames for the next attempt.
+/// The solve's outputs into the stage's output folder: moved when it finished (its checkpoint
+/// first removed, so that nothing resumes a finished run; the runner then removes the resume
+/// folder), hard-linked with its summary when it did not, so that failed/solve/ holds them
+/// while the resume folder keeps its checkpoint and frames for the next attempt.
 void hand_over_results(const fs::path& from, const fs::path& to, bool finished) {
-  for (const char* name : {"results.pvd", "history.csv", "results"}) {
+  if (finished) fs::remove(from / "checkpoint.bin");
+  for (const char* name : {"results.pvd", "history.csv", "summary.yaml", "results"}) {
     const fs::path src = from / name, dst = to / name;
     if (!fs::exists(src)) continue;
     if (finished) {
-      fs::rename(src, dst);
+      if (std::string(name) != "summary.yaml") fs::rename(src, dst);  // the stage's summary is the runner's to write
       continue;
     }
     if (!fs::is_directory(src)) {
@@ -397,18 +405,31 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
     const bool mpi = cfg.simulation.ranks > 1;
     if (mpi) files::write_atomic(run_scene, scene_text(cfg, artifacts(cfg, ctx.work_dir())));
     const solver::SceneDesc scene = mpi ? solver::read_scene(run_scene) : solver::read_scene(text, final_scene);
-    const SolveRun run = prepare_solve_run(scene, ctx.resume_dir());
+    SolveRun run = prepare_solve_run(scene, ctx.resume_dir(), cfg.output.checkpoint_every);
     int status = 0;
     std::string mpi_end;
     if (!mpi) {
       solver::SolveOptions o;
       o.output_dir = run.dir;
       o.restart = run.restart;
-      status = solver::solve(scene, o, ctx.summary());
+      o.checkpoint_every = cfg.output.checkpoint_every;
+      try {
+        status = solver::solve(scene, o, ctx.summary());
+      } catch (const InputError& e) {
+        if (!run.restart) throw;
+        // A checkpoint the fingerprint accepted but the model cannot take (its state or
+        // history has another size or kind): the run starts over.
+        log::info("not resuming from {}: {}; the solve starts from the beginning", run.restart->string(), e.what());
+        empty_folder(run.dir);
+        o.restart.reset();
+        ctx.summary() = Summary{};
+        status = solver::solve(scene, o, ctx.summary());
+      }
     } else {
       std::vector<std::string> argv = mpi_launcher(cfg.simulation.ranks);
       for (const std::string& a : {pipeline::self_executable().string(), std::string("solve"), run_scene.string(),
-                                  std::string("--out"), run.dir.string()})
+                                  std::string("--out"), run.dir.string(), std::string("--checkpoint-every"),
+                                  std::to_string(cfg.output.checkpoint_every)})
         argv.push_back(a);
       if (run.restart) argv.insert(argv.end(), {"--restart", run.restart->string()});
       const auto start = std::chrono::steady_clock::now();

@@ -101,7 +101,7 @@ std::string checkpoint_refusal(const SceneDesc& scene, const std::filesystem::pa
     const std::string differ =
         fingerprint_difference(ck, state_fingerprint(scene, scene_state_hashes(scene), ck.get_scalar("solver/time")));
     return differ.empty() ? std::string() : fmt::format("it was written by another scene (what differs: {})", differ);
-  } catch (const std::exception& e) {
+  } catch (const InputError& e) {  // damaged, truncated, another format: not an I/O failure, which propagates
     return fmt::format("it cannot be read ({})", e.what());
   }
 }

@@ -51,8 +51,8 @@ void put_fingerprint(HistoryArchive& out, const std::map<std::string, std::strin
 void check_fingerprint(const HistoryArchive& in, const std::map<std::string, std::string>& parts,
                        const std::string& checkpoint, const std::string& scene);
 
-/// Why `file` cannot resume a run of `scene` (missing, unreadable or damaged, written by
-/// another scene); empty when it can.
+/// Why `file` cannot resume a run of `scene` (missing, damaged, written by another scene);
+/// empty when it can. A failure to read it at all (I/O) throws.
 std::string checkpoint_refusal(const SceneDesc& scene, const std::filesystem::path& file);
 
 }  // namespace stentsim::solver

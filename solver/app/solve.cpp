@@ -76,7 +76,13 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     for (const auto& [prefix, o] : observers) o->decorate(meshes, u);
     writer.write_frame(writer.frames(), t, meshes);
   };
+  std::vector<std::string> columns{"step", "time", "dt", "load_factor", "newton_iterations", "linear_iterations", "step_cuts",
+                                   "wall_time_s", "assembly_s", "linear_solve_s"};
+  for (const auto& [name, p] : built->pressures) columns.push_back("pressure_" + name);
+  for (const auto& [prefix, o] : observers)
+    for (const auto& c : o->history_columns()) columns.push_back(c);
   const std::filesystem::path checkpoint_file = out_dir / "checkpoint.bin";
+  const int checkpoint_every = options.checkpoint_every.value_or(scene.checkpoint_every);
   RunCounters counters;
   double t_last = stepping.t_start;
   const std::map<std::string, std::string> scene_hashes = scene_state_hashes(scene);  // the files as this run read them
@@ -86,6 +92,12 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     // Before the state's size: another scene's checkpoint is named as such.
     check_fingerprint(ck, state_fingerprint(scene, scene_hashes, ck.get_scalar("solver/time")), from.string(),
                       scene.file.string());
+    // The history's columns (the scene's pressures and QoIs) must be the ones this run writes.
+    const std::string history = ck.get_text("results/history"), header = fmt::format("{}", fmt::join(columns, ","));
+    if (history.substr(0, history.find('\n')) != header)
+      throw InputError(fmt::format("{}: the checkpoint's history.csv has other columns than {} writes (its pressures or "
+                                   "QoIs changed); a checkpoint resumes only the run that wrote it: run without --restart",
+                                   from.string(), scene.file.string()));
     const SolverCheckpoint state = SolverCheckpoint::get(ck, model.dofs.size());
     u = state.u;
     model.load_history(ck);
@@ -104,11 +116,6 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   }
   for (const auto& [prefix, o] : observers) o->start(u, options.restart.has_value());
 
-  std::vector<std::string> columns{"step", "time", "dt", "load_factor", "newton_iterations", "linear_iterations", "step_cuts",
-                                   "wall_time_s", "assembly_s", "linear_solve_s"};
-  for (const auto& [name, p] : built->pressures) columns.push_back("pressure_" + name);
-  for (const auto& [prefix, o] : observers)
-    for (const auto& c : o->history_columns()) columns.push_back(c);
   if (!options.restart) writer.history_header(columns);
   const LoadCurve* lf = scene.load_factor_curve.empty() ? nullptr : &scene.curves.at(scene.load_factor_curve);
   auto on_step = [&](const StepRecord& r) {
@@ -129,7 +136,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     bool at_stop = same_time(r.time, stepping.t_end, stepping.t_end);
     for (double s : stepping.stops) at_stop = at_stop || same_time(r.time, s, stepping.t_end);
     if (r.step % scene.output_every == 0 || at_stop) frame(r.time);
-    if (scene.checkpoint_every > 0 && r.step % scene.checkpoint_every == 0 && writes) {
+    if (checkpoint_every > 0 && r.step % checkpoint_every == 0 && writes) {
       HistoryArchive ck;
       SolverCheckpoint{u, r.time, r.next_dt, r.increment, r.dt, counters}.put(ck);
       put_fingerprint(ck, state_fingerprint(scene, scene_hashes, r.time));

@@ -25,6 +25,8 @@ struct SolveOptions {
   /// Resume from a checkpoint (output.checkpoint_every); an empty path means
   /// <output folder>/checkpoint.bin. The scene must be the one that wrote it.
   std::optional<std::filesystem::path> restart;
+  /// Overrides output.checkpoint_every of the scene (the case's solve stage sets its own).
+  std::optional<int> checkpoint_every;
 };
 
 /// Runs a parsed scene (the case pipeline calls this in-process). Returns 0 on

@@ -32,7 +32,7 @@ class ActiveSet {
     return changes_[i] + (static_cast<bool>(iterate_[i]) != active ? 1 : 0);
   }
   struct Changes {
-    int active = 0, entered = 0, left = 0;  // this rank's points
+    int active = 0, entered = 0, left = 0;  // in the new iterate: the points this rank evaluated, the others as committed
   };
   /// Term::accept: the evaluated state is the new iterate; what changed from the last one.
   Changes accept() {

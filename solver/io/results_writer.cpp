@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <set>
+#include <vector>
+
 #include "common/files.hpp"
 
 namespace stentsim::solver {
@@ -19,6 +22,10 @@ void ResultsWriter::write_frame(int frame, double time, const std::vector<std::p
   }
   ++frames_;
   last_time_ = time;
+  write_pvd();
+}
+
+void ResultsWriter::write_pvd() const {
   files::write_atomic(dir_ / "results.pvd", "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n" +
                                                 pvd_body_ + "  </Collection>\n</VTKFile>\n");
 }
@@ -48,16 +55,18 @@ void ResultsWriter::load(const HistoryArchive& in) {
   frames_ = static_cast<int>(in.get_scalar("results/frames"));
   last_time_ = in.get_scalar("results/last_time");
   files::write_atomic(dir_ / "history.csv", history_);
-  // Frames the interrupted run wrote after its checkpoint are in no PVD entry now: remove them,
-  // the resumed run writes its own.
-  for (const auto& entry : std::filesystem::directory_iterator(dir_ / "results")) {
-    const std::string name = entry.path().filename().string();
-    const std::size_t end = name.size() >= 4 ? name.size() - 4 : 0, begin = name.rfind('_', end);
-    if (begin == std::string::npos || name.compare(end, 4, ".vtu") != 0 || end - begin != 6) continue;
-    const std::string digits = name.substr(begin + 1, 5);
-    if (digits.find_first_not_of("0123456789") == std::string::npos && std::stoi(digits) >= frames_)
-      std::filesystem::remove(entry.path());
+  // What the interrupted run wrote after its checkpoint (later frames, a frame cut short)
+  // is in no PVD entry now: removed, and the PVD is the checkpoint's again.
+  std::set<std::string> listed;
+  for (std::size_t at = pvd_body_.find("file=\"results/"); at != std::string::npos; at = pvd_body_.find("file=\"results/", at + 1)) {
+    const std::size_t begin = at + 14, end = pvd_body_.find('"', begin);
+    listed.insert(pvd_body_.substr(begin, end - begin));
   }
+  std::vector<std::filesystem::path> stale;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_ / "results"))
+    if (!listed.count(entry.path().filename().string())) stale.push_back(entry.path());
+  for (const auto& f : stale) std::filesystem::remove_all(f);
+  write_pvd();
 }
 
 }  // namespace stentsim::solver

@@ -27,6 +27,7 @@ class ResultsWriter {
 
  private:
   std::filesystem::path dir_;
+  void write_pvd() const;
   std::string pvd_body_, history_;
   int frames_ = 0;
   double last_time_ = -1e300;

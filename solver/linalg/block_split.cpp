@@ -51,13 +51,10 @@ CsrMatrix amg_matrix(const CsrMatrix& a11) {
   return m;
 }
 
-bool amg_matrix_on(const CsrMatrix& a11, const std::vector<std::int64_t>& row_ptr, const std::vector<std::int64_t>& cols,
-                   CsrMatrix& out) {
+bool amg_values_on(const CsrMatrix& a11, const std::vector<std::int64_t>& row_ptr, const std::vector<std::int64_t>& cols,
+                   std::vector<double>& values) {
   if (row_ptr.size() != a11.row_ptr.size()) return false;
-  out.rows = a11.rows;
-  out.row_ptr = row_ptr;
-  out.cols = cols;
-  out.values.resize(cols.size());
+  values.resize(cols.size());
   for (std::int64_t i = 0; i < a11.rows; ++i) {
     auto k = a11.row_ptr[static_cast<std::size_t>(i)];
     const auto k_end = a11.row_ptr[static_cast<std::size_t>(i) + 1];
@@ -66,7 +63,7 @@ bool amg_matrix_on(const CsrMatrix& a11, const std::vector<std::int64_t>& row_pt
       const std::int64_t j = cols[static_cast<std::size_t>(p)];
       while (k < k_end && a11.cols[static_cast<std::size_t>(k)] < j) ++k;
       if (k == k_end || a11.cols[static_cast<std::size_t>(k)] != j) return false;
-      out.values[static_cast<std::size_t>(p)] = a11.values[static_cast<std::size_t>(k)];
+      values[static_cast<std::size_t>(p)] = a11.values[static_cast<std::size_t>(k)];
     }
   }
   return true;

@@ -38,9 +38,10 @@ BlockSplit split_blocks(const CsrMatrix& a, std::int64_t begin, std::int64_t end
 /// on: the entries that fill later (contact couplings of surface nodes that share no
 /// element) act through GMRES's operator, not through the V-cycle.
 CsrMatrix amg_matrix(const CsrMatrix& a11);
-/// A11's values at the positions of an earlier amg_matrix's pattern (row_ptr, cols). False
-/// when that pattern has a position `a11` lacks (another model); `out` is then undefined.
-bool amg_matrix_on(const CsrMatrix& a11, const std::vector<std::int64_t>& row_ptr, const std::vector<std::int64_t>& cols,
-                   CsrMatrix& out);
+/// A11's values at the positions of an earlier amg_matrix's pattern (row_ptr, cols), in
+/// that pattern's order. False when that pattern has a position `a11` lacks (another model);
+/// `values` is then undefined.
+bool amg_values_on(const CsrMatrix& a11, const std::vector<std::int64_t>& row_ptr, const std::vector<std::int64_t>& cols,
+                   std::vector<double>& values);
 
 }  // namespace stentsim::solver

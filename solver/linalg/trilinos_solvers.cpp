@@ -90,11 +90,13 @@ struct KeptMatrix {
   }
 
   /// New values of the kept pattern (holds(a) must be true).
-  void refill(const CsrMatrix& a) {
+  void refill(const CsrMatrix& a) { refill(a.values); }
+  /// New values in the kept pattern's order.
+  void refill(const std::vector<double>& v) {
     matrix->resumeFill();
     {
       const auto values = matrix->getLocalMatrixHost().values;
-      for (std::size_t k = 0; k < a.values.size(); ++k) values(k) = a.values[k];
+      for (std::size_t k = 0; k < v.size(); ++k) values(k) = v[k];
     }
     matrix->fillComplete();
   }
@@ -365,16 +367,15 @@ class TrilinosSolver : public LinearSolver {
       throw std::logic_error("gmres_amg_block: no AMG block was set (set_amg_block)");
     split_ = split_blocks(a, block_begin_, block_end_);
     // The AMG's A11 keeps the pattern its hierarchy was built on (amg_matrix, block_split.hpp).
-    CsrMatrix m11;
-    bool same = block_amg_ && block_.matrix && amg_matrix_on(split_.a11, block_.row_ptr, block_.cols, m11) && block_.holds(m11);
+    bool same = block_amg_ && block_.matrix && amg_values_on(split_.a11, block_.row_ptr, block_.cols, amg_values_);
     RCP<const Map> map1;
     if (same) {
-      block_.refill(m11);
+      block_.refill(amg_values_);
       same = reuse_amg(block_.matrix, *block_amg_);
       map1 = block_.matrix->getRowMap();
     }
     if (!same) {
-      m11 = amg_matrix(split_.a11);
+      const CsrMatrix m11 = amg_matrix(split_.a11);
       map1 = rcp(new Map(static_cast<GO>(m11.rows), 0, comm_));
       RCP<Matrix> m = build_matrix(m11, map1);
       block_amg_ = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(
@@ -520,6 +521,7 @@ class TrilinosSolver : public LinearSolver {
   std::int64_t block_begin_ = 0, block_end_ = 0;
   BlockSplit split_;
   KeptMatrix block_;
+  std::vector<double> amg_values_;  // block 1's AMG matrix values (scratch, kept for its capacity)
   RCP<MueLu::TpetraOperator<SC, LO, GO, NO>> block_amg_;
   UmfpackFactor block_lu_{false};  // no iterative refinement: GMRES corrects the block solve
   Eigen::MatrixXd modes_;

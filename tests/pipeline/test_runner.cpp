@@ -380,3 +380,44 @@ TEST_F(RunnerTest, StageSummaryRecordsTimeAndMemory) {
 }
 
 }  // namespace
+
+namespace {
+
+// A stage that counts its attempts in its resume folder and fails while its config says so.
+Stage attempt_counter(const std::string& config) {
+  Stage s;
+  s.name = "r";
+  s.outputs = {"r/out.txt"};
+  s.config = config;
+  s.run = [config](StageContext& ctx) {
+    const fs::path counter = ctx.resume_dir() / "attempts";
+    const int n = (fs::exists(counter) ? std::stoi(files::read_text(counter)) : 0) + 1;
+    files::write_atomic(counter, std::to_string(n));
+    if (config == "fail") throw ComputeError("not yet");
+    files::write_atomic(ctx.output("r/out.txt"), "attempts " + std::to_string(n) + "\n");
+  };
+  return s;
+}
+
+}  // namespace
+
+// What a stage keeps in its resume folder outlives its failed attempts, goes when the
+// stage is forced (from the beginning) and when it has succeeded.
+TEST_F(RunnerTest, ResumeFolderOutlivesFailuresAndGoesOnForceAndSuccess) {
+  auto run_r = [&](const std::string& config, RunOptions o = {}) {
+    Runner r(Plan({attempt_counter(config)}, work), "test");
+    std::ostringstream out;
+    return r.run(o, out);
+  };
+  const fs::path counter = work / ".resume/r/attempts";
+  EXPECT_EQ(run_r("fail").exit_code(), 1);
+  EXPECT_EQ(run_r("fail").exit_code(), 1);
+  EXPECT_EQ(files::read_text(counter), "2");
+  RunOptions forced;
+  forced.force = {"r"};
+  EXPECT_EQ(run_r("fail", forced).exit_code(), 1);
+  EXPECT_EQ(files::read_text(counter), "1") << "a forced stage starts from the beginning";
+  EXPECT_EQ(run_r("ok").exit_code(), 0);
+  EXPECT_EQ(files::read_text(work / "r/out.txt"), "attempts 2\n");
+  EXPECT_FALSE(fs::exists(work / ".resume")) << "nothing is left to resume after a success";
+}

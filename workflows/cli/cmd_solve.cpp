@@ -8,6 +8,7 @@ namespace stentsim::cli {
 void register_solve(CLI::App& app) {
   struct Args {
     std::string scene, out, linear, restart;
+    int checkpoint_every = -1;
     bool verbose = false;
   };
   auto a = std::make_shared<Args>();
@@ -20,12 +21,15 @@ void register_solve(CLI::App& app) {
   auto* restart = sub->add_option("--restart", a->restart,
                                   "Resume from a checkpoint (output.checkpoint_every); default: OUT/checkpoint.bin")
                       ->expected(0, 1);
+  sub->add_option("--checkpoint-every", a->checkpoint_every, "Write checkpoint.bin every N steps (overrides output.checkpoint_every)")
+      ->check(CLI::Range(0, 1000000));
   on(sub, [a, restart] {
     solver::SolveOptions o;
     o.output_dir = a->out;
     if (!a->linear.empty()) o.linear_solver = solver::parse_linear_solver(a->linear, "--linear-solver");
     o.verbose = a->verbose;
     if (restart->count() > 0) o.restart = std::filesystem::path(a->restart);
+    if (a->checkpoint_every >= 0) o.checkpoint_every = a->checkpoint_every;
     // solve_scene returns non-zero when the computation could not finish
     // (last converged state written); the CLI's code for that is 1.
     return solver::solve_scene(a->scene, o) == 0 ? 0 : 1;
