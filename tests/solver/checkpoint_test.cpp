@@ -3,8 +3,14 @@
 // before the predictor existed) read as "no guess for the first step".
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "solver/app/checkpoint.hpp"
+#include "solver/io/results_writer.hpp"
 
 namespace stentsim::solver {
 namespace {
@@ -46,6 +52,42 @@ TEST(SolverCheckpoint, WithoutPredictorStateResumesWithoutAGuess) {
   EXPECT_EQ(r.last_increment.size(), 0);
   EXPECT_EQ(r.last_dt, 0.0);
   EXPECT_EQ(r.counters.predicted_steps, 0);
+}
+
+// A restart's results writer continues from its checkpoint: what the interrupted run wrote
+// after it (later frames, a frame cut short) is removed and the PVD lists the checkpoint's
+// frames again.
+TEST(ResultsWriterRestart, RemovesWhatTheInterruptedRunWroteAfterItsCheckpoint) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("stentsim-writer-restart-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  MeshData m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  m.add_cell(CellType::tetra, {0, 1, 2, 3});
+  HistoryArchive ck;
+  {
+    ResultsWriter w(dir);
+    w.history_header({"step", "time"});
+    w.write_frame(0, 0.0, {{"body", m}});
+    w.history_row({1, 0.5});
+    w.write_frame(1, 0.5, {{"body", m}});
+    w.save(ck);  // the checkpoint after step 1
+    w.history_row({2, 1.0});
+    w.write_frame(2, 1.0, {{"body", m}});  // then interrupted, a frame half written
+    files::write_atomic(dir / "results/.body_00003.vtu.tmp-1", "cut short");
+  }
+  ResultsWriter resumed(dir);
+  resumed.load(ck);
+  EXPECT_TRUE(fs::exists(dir / "results/body_00000.vtu"));
+  EXPECT_TRUE(fs::exists(dir / "results/body_00001.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "results/body_00002.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "results/.body_00003.vtu.tmp-1"));
+  const std::string pvd = files::read_text(dir / "results.pvd");
+  EXPECT_NE(pvd.find("body_00001.vtu"), std::string::npos) << pvd;
+  EXPECT_EQ(pvd.find("body_00002.vtu"), std::string::npos) << pvd;
+  EXPECT_EQ(files::read_text(dir / "history.csv"), "step,time\n1,0.5\n");
+  EXPECT_EQ(resumed.frames(), 2);
+  fs::remove_all(dir);
 }
 
 }  // namespace
