@@ -20,6 +20,8 @@ void SolverCheckpoint::put(HistoryArchive& out) const {
   out.put("solver/step_cuts", static_cast<double>(counters.step_cuts));
   out.put("solver/steps", static_cast<double>(counters.steps));
   out.put("solver/predicted_steps", static_cast<double>(counters.predicted_steps));
+  out.put("solver/floor_steps", static_cast<double>(counters.floor_steps));
+  out.put("solver/worst_floor", counters.worst_floor);
   out.put("solver/last_increment", std::span<const double>(last_increment.data(), static_cast<std::size_t>(last_increment.size())));
   out.put("solver/last_dt", last_dt);
 }
@@ -36,6 +38,8 @@ SolverCheckpoint SolverCheckpoint::get(const HistoryArchive& in, long long dofs)
   c.counters.steps = static_cast<int>(in.get_scalar("solver/steps"));
   // Checkpoints written without a predictor state resume without a guess for their first step.
   if (in.has("solver/predicted_steps")) c.counters.predicted_steps = static_cast<int>(in.get_scalar("solver/predicted_steps"));
+  if (in.has("solver/floor_steps")) c.counters.floor_steps = static_cast<int>(in.get_scalar("solver/floor_steps"));
+  if (in.has("solver/worst_floor")) c.counters.worst_floor = in.get_scalar("solver/worst_floor");
   if (in.has("solver/last_increment") && !in.get("solver/last_increment").empty()) {
     const auto& inc = in.get("solver/last_increment", dofs);
     c.last_increment = Eigen::Map<const Eigen::VectorXd>(inc.data(), static_cast<Eigen::Index>(inc.size()));

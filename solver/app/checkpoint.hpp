@@ -17,6 +17,8 @@ struct RunCounters {
   long newton_iterations = 0, linear_iterations = 0, step_cuts = 0;
   int steps = 0;
   int predicted_steps = 0;  // steps whose converged attempt started from the predictor's guess
+  int floor_steps = 0;      // steps that converged at the residual floor (newton.hpp)
+  double worst_floor = 0.0; // their largest |R| relative to the forces in balance
 };
 
 struct SolverCheckpoint {

@@ -125,6 +125,10 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     counters.linear_iterations += r.linear_iterations;
     counters.step_cuts += r.cuts;
     counters.predicted_steps += r.predicted ? 1 : 0;
+    if (r.at_floor) {
+      ++counters.floor_steps;
+      counters.worst_floor = std::max(counters.worst_floor, r.residual_at_floor / r.force_magnitude);
+    }
     for (const auto& [prefix, o] : observers) o->step(r, u);
     std::vector<double> row{static_cast<double>(r.step), r.time, r.dt, lf ? (*lf)(r.time) : r.time,
                             static_cast<double>(r.newton_iterations), static_cast<double>(r.linear_iterations),
@@ -181,6 +185,9 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   summary.set("linear_iterations", static_cast<double>(counters.linear_iterations));
   summary.set("step_cuts", static_cast<double>(counters.step_cuts));
   summary.set("predicted_steps", static_cast<double>(counters.predicted_steps));
+  // Steps taken as converged at the residual floor, and their largest |R| / |m| (newton.hpp).
+  summary.set("floor_steps", static_cast<double>(counters.floor_steps));
+  if (counters.floor_steps > 0) summary.set("worst_floor_residual", counters.worst_floor);
   summary.set("dofs", static_cast<double>(model.dofs.size()));
   summary.set("final_time", t_last, "s");
   summary.note("scene", file);

@@ -16,6 +16,7 @@ GlobalSystem::GlobalSystem(const Constraints& constraints) : constraints_(constr
 void GlobalSystem::begin(const Eigen::VectorXd& prescribed, bool with_tangent) {
   const GlobalDof n = constraints_.size();
   residual_.setZero(n);
+  magnitude_.setZero(n);
   correction_.setZero(n);
   prescribed_ = prescribed;
   with_tangent_ = with_tangent;
@@ -69,6 +70,7 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
     const GlobalDof gi = dofs[static_cast<std::size_t>(i)];
     if (gi < 0) continue;
     residual_(gi) += rv(i);
+    magnitude_(gi) += std::abs(rv(i));
     if (!tangent || constraints_.fixed(gi)) continue;
     for (Eigen::Index j = 0; j < n; ++j) {
       const GlobalDof gj = dofs[static_cast<std::size_t>(j)];
@@ -86,6 +88,7 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
 void GlobalSystem::finish() {
   if (ranks_ > 1) {
     parallel::sum(residual_);
+    parallel::sum(magnitude_);
     if (with_tangent_) parallel::sum(correction_);
   }
   if (!with_tangent_) return;
@@ -127,6 +130,13 @@ double GlobalSystem::free_residual_norm() const {
   double s = 0.0;
   for (GlobalDof d = 0; d < residual_.size(); ++d)
     if (!constraints_.fixed(d)) s += residual_(d) * residual_(d);
+  return std::sqrt(s);
+}
+
+double GlobalSystem::force_magnitude_norm() const {
+  double s = 0.0;
+  for (GlobalDof d = 0; d < magnitude_.size(); ++d)
+    if (!constraints_.fixed(d)) s += magnitude_(d) * magnitude_(d);
   return std::sqrt(s);
 }
 

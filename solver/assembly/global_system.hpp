@@ -37,6 +37,10 @@ class GlobalSystem : public Assembler {
   const Eigen::VectorXd& residual() const { return residual_; }
   /// Norm of the residual over free DOFs.
   double free_residual_norm() const;
+  /// Size of the forces in balance: the norm over free DOFs of m_d = Σ_c |r_c,d|, the
+  /// magnitudes of every contribution c (element, contact point, load) to DOF d. At
+  /// equilibrium the residual cancels them; |R| / |m| says how far from complete that is.
+  double force_magnitude_norm() const;
   /// Right-hand side of K du = rhs: -(R + K_fc du_c) at free DOFs, du_c at fixed ones.
   Eigen::VectorXd rhs() const;
   const CsrMatrix& matrix() const { return matrix_; }
@@ -45,7 +49,7 @@ class GlobalSystem : public Assembler {
   void insert(GlobalDof row, GlobalDof col, double value);
 
   const Constraints& constraints_;
-  Eigen::VectorXd residual_, correction_, prescribed_;
+  Eigen::VectorXd residual_, correction_, prescribed_, magnitude_;
   CsrMatrix matrix_;
   std::vector<std::tuple<GlobalDof, GlobalDof, double>> pending_;  // entries outside the pattern
   bool with_tangent_ = true;

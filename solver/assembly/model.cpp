@@ -38,6 +38,15 @@ void Model::begin_step(const Eigen::VectorXd& u, double time, double dt) {
   if (!failure.empty()) throw ElementFailure(failure);
 }
 
+int Model::accepted_changes() const {
+  int n = 0;
+  for (const auto& t : terms) n += t->accepted_changes();
+  if (ranks == 1) return n;
+  Eigen::VectorXd v = Eigen::VectorXd::Constant(1, n);
+  parallel::sum(v);  // collective: every rank calls it after every accept
+  return static_cast<int>(v[0]);
+}
+
 Eigen::MatrixXd Model::rigid_body_modes(const std::vector<std::pair<GlobalDof, Vec3>>& nodes) const {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(dofs.size(), 6);
   for (const auto& [first, x] : nodes) {

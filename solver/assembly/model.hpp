@@ -37,6 +37,8 @@ class Model {
   void begin_step(const Eigen::VectorXd& u, double time, double dt);
   void trial(const Eigen::VectorXd& du) { for (auto& t : terms) t->trial(du); }
   void accept() { for (auto& t : terms) t->accept(); }
+  /// Active-set changes of the last accept() over all terms and ranks.
+  int accepted_changes() const;
   void commit() { for (auto& t : terms) t->commit(); }
   void rollback() { for (auto& t : terms) t->rollback(); }
   /// Restart: every term's committed history under "term/<index>:<name>/".

@@ -87,7 +87,12 @@ class BeamToSurfacePair : public Term {
   /// Every rank evaluated its own elements only: the flags are gathered so that every rank
   /// (and rank 0's checkpoint) holds all of them.
   void commit() override;
-  void accept() override { ActiveSet::log_changes(name_, active_.accept()); }
+  void accept() override {
+    const ActiveSet::Changes c = active_.accept();
+    accepted_changes_ = c.entered + c.left;
+    ActiveSet::log_changes(name_, c);
+  }
+  int accepted_changes() const override { return accepted_changes_; }
   void rollback() override { active_.rollback(); }
   /// The active flags of the last converged state (the projection-failure rule needs them).
   bool has_history() const override { return true; }
@@ -137,6 +142,7 @@ class BeamToSurfacePair : public Term {
   std::vector<Vec3> searched_points_, searched_nodes_;
   std::vector<std::vector<int>> reserved_;  // per element, the faces whose pattern was reserved (sorted)
   ActiveSet active_;  // per Gauss point (element-major)
+  int accepted_changes_ = 0;  // points the last accept() switched
   long long searches_ = 0;
   int unconverged_ = 0;  // points left nowhere with a failed projection, in the last tangent assembly
   int rank_ = 0, ranks_ = 1;  // partition of the last assembly

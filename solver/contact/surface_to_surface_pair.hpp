@@ -100,7 +100,12 @@ class SurfaceToSurfacePair : public Term {
   void begin_step(const SystemState& state) override;
   void assemble(const SystemState& state, Assembler& out) override;
   void commit() override;
-  void accept() override { ActiveSet::log_changes(name_, active_.accept()); }
+  void accept() override {
+    const ActiveSet::Changes c = active_.accept();
+    accepted_changes_ = c.entered + c.left;
+    ActiveSet::log_changes(name_, c);
+  }
+  int accepted_changes() const override { return accepted_changes_; }
   void rollback() override { active_.rollback(); }
   /// The nodal active flags of the last converged state (the chattering count starts from them).
   bool has_history() const override { return true; }
@@ -160,6 +165,7 @@ class SurfaceToSurfacePair : public Term {
   bool pattern_reserved_ = false;
   Candidates reserved_;  // per slave node, the master faces of the block reserved last (sorted)
   ActiveSet active_;  // per slave node
+  int accepted_changes_ = 0;  // nodes the last accept() switched
   long long searches_ = 0;
 };
 

@@ -357,6 +357,8 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   scene.newton.residual_tolerance = nw.number("residual_tolerance", 1e-8, Range::positive());
   scene.newton.residual_absolute = nw.number("residual_absolute", 1e-10, Range::non_negative());
   scene.newton.increment_tolerance = nw.number("increment_tolerance", 1e-8, Range::positive());
+  scene.newton.floor_tolerance = nw.number("floor_tolerance", 1e-6, Range::non_negative());
+  scene.newton.floor_iterations = nw.integer("floor_iterations", 2, Range::between(1, 100));
   scene.newton.line_search_steps = nw.integer("line_search_steps", 6, Range::between(0, 30));
   scene.newton.predictor = nw.choice("predictor", {"extrapolate", "none"}, "extrapolate") == "extrapolate";
   scene.newton.inexact = nw.choice("forcing", {"eisenstat_walker", "none"}, "eisenstat_walker") == "eisenstat_walker";

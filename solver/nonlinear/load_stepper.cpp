@@ -52,6 +52,9 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
         rec.dt = h;
         rec.residual_norms = nr.residual_norms;
         rec.predicted = nr.predicted;
+        rec.at_floor = nr.at_floor;
+        rec.residual_at_floor = nr.at_floor ? nr.residual_norms.back() : 0.0;
+        rec.force_magnitude = nr.force_magnitude;
         if (guess.size() == nr.increment.size())
           log::debug("  predictor: |increment| = {:.3e}, |guess| = {:.3e}, |increment - guess| = {:.3e}", nr.increment.norm(),
                      guess.norm(), (nr.increment - guess).norm());
@@ -98,8 +101,11 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
     const double eta = t > s.t_start ? elapsed * (s.t_end - t) / (t - s.t_start) : 0.0;
     // The progress line names the load reached (issue 6), e.g. "p = 0.12 MPa", when the scene can describe it.
     const std::string load = s.describe_load ? s.describe_load(t) : fmt::format("t = {:.4g}", t);
-    log::info("step {} {} dt = {:.3g}: {} Newton its, {} linear its, {} cuts, {:.2f} s, ETA {:.0f} s", step, load,
-              rec.dt, rec.newton_iterations, rec.linear_iterations, cuts, rec.wall_seconds, eta);
+    log::info("step {} {} dt = {:.3g}: {} Newton its, {} linear its, {} cuts, {:.2f} s, ETA {:.0f} s{}", step, load,
+              rec.dt, rec.newton_iterations, rec.linear_iterations, cuts, rec.wall_seconds, eta,
+              rec.at_floor ? fmt::format("; at the residual floor |R| = {:.2e} ({:.1e} of the forces in balance)",
+                                         rec.residual_at_floor, rec.residual_at_floor / rec.force_magnitude)
+                           : std::string());
     on_step(rec);
   }
 }

@@ -71,6 +71,8 @@ struct StepRecord {
   double linear_setup_seconds = 0.0;  // part of linear_seconds: matrix build, factorization / preconditioner
   double next_dt = 0.0;        // the step size the stepper tries next (restart resumes with it)
   bool predicted = false;      // the converged attempt started from the predictor's guess
+  bool at_floor = false;       // ... converged at the residual floor (newton.hpp)
+  double residual_at_floor = 0.0, force_magnitude = 0.0;  // its |R| and |m| [N]
   Eigen::VectorXd increment;   // the step's increment (the next step's predictor; checkpointed)
   std::vector<double> residual_norms;
 };

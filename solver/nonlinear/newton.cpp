@@ -125,6 +125,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
   }
   res.residual_norms.push_back(r_norm);
 
+  int steady = 0;               // consecutive iterations that neither halved |R| nor changed an active set (floor test)
   double prev_du_norm = 0.0;    // the last iteration's correction
   bool prev_full_step = false;  // ... and whether the line search took all of it
   double eta = 0.0, prev_r_norm = 0.0;  // the forcing term of the last solve and the residual it started from
@@ -210,7 +211,11 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
       if (std::string e = assemble_at(u, prescribed, true); !e.empty()) return fail(e);
     }
     model.accept();
+    const int changes = model.accepted_changes();
+    const double r_before = r_norm;
     r_norm = system.free_residual_norm();
+    steady = r_norm > 0.5 * r_before && changes == 0 ? steady + 1 : 0;
+    res.force_magnitude = system.force_magnitude_norm();
     scale = std::max(scale, reaction_norm(model.constraints, system.residual()));
     res.residual_norms.push_back(r_norm);
     const double du_norm = step.norm();
@@ -229,8 +234,8 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     const bool r_ok = r_norm <= settings.residual_tolerance * scale + settings.residual_absolute;
     const bool du_ok = du_error <= settings.increment_tolerance * std::max(u.norm(), 1e-12) ||
                        du_norm <= settings.increment_absolute || r_norm == 0.0;
-    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}{}, set-up {:.2f} s, "
-               "solve {:.2f} s", it, r_norm, scale, du_norm, best_alpha, ls.iterations,
+    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}, forces {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}{}, set-up {:.2f} s, "
+               "solve {:.2f} s", it, r_norm, scale, res.force_magnitude, du_norm, best_alpha, ls.iterations,
                eta > 0.0 ? fmt::format(" to {:.1e}", eta) : std::string(),
                ls.amg_levels > 0 ? fmt::format(" (AMG levels {}{})", ls.amg_levels, ls.preconditioner_built ? ", built" : "")
                                  : std::string(),
@@ -244,6 +249,16 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     const bool stagnated = du_norm <= 1e-13 * std::max(u.norm(), 1e-300) && it > 1 && ls.converged;
     if ((r_ok && du_ok) || stagnated) {
       res.converged = true;
+      return res;
+    }
+    // The residual floor (header): only for a residual above its tolerance (a state within
+    // it that still moves is resolved by the increment test as before).
+    if (!r_ok && settings.floor_tolerance > 0.0 && steady >= settings.floor_iterations &&
+        r_norm <= settings.floor_tolerance * res.force_magnitude) {
+      log::debug("  converged at the residual floor: |R| = {:.3e} <= {:g} x forces in balance {:.3e}, neither halved nor an "
+                 "active set changed in {} iterations",
+                 r_norm, settings.floor_tolerance, res.force_magnitude, steady);
+      res.converged = res.at_floor = true;
       return res;
     }
     if (!std::isfinite(r_norm) || r_norm > 1e10 * std::max(scale, 1e-30)) return fail("residual diverges");

@@ -71,6 +71,9 @@ class Term {
   virtual void trial(const Eigen::VectorXd& du) {}
   /// The last trial becomes the accepted iterate.
   virtual void accept() {}
+  /// Points whose active state (contact) the last accept() changed on this rank: Newton's
+  /// residual-floor test needs a settled active set (newton.hpp).
+  virtual int accepted_changes() const { return 0; }
   /// The load step converged: history and reference states move forward.
   virtual void commit() {}
   /// The load step is cut: go back to the last committed state.

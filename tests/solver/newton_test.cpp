@@ -102,6 +102,76 @@ TEST(SolverNewton, InexactNewtonSavesKrylovIterations) {
   EXPECT_FALSE(make_linear_solver({})->set_relative_tolerance(1e-3));
 }
 
+// A residual floor: forces that vary with u at a scale far below any Newton correction (a
+// triangle wave of period 1e-9 mm on the top face's z DOFs) and that the tangent cannot see,
+// as the kinks of element-based contact integration act on a sliding balloon. No iteration
+// lowers |R| below the wave's amplitude; the floor test takes that state as converged when
+// it is small against the forces in balance and no active set changes, and only then.
+class ResidualFloorTerm : public Term {
+ public:
+  ResidualFloorTerm(std::vector<GlobalDof> dofs, double amplitude, bool unsettled)
+      : dofs_(std::move(dofs)), amplitude_(amplitude), unsettled_(unsettled) {}
+  std::string name() const override { return "floor"; }
+  int accepted_changes() const override { return unsettled_ ? 1 : 0; }  // as a contact pair whose points still switch
+  void assemble(const SystemState& state, Assembler& out) override {
+    Eigen::VectorXd r(static_cast<Eigen::Index>(dofs_.size()));
+    for (std::size_t i = 0; i < dofs_.size(); ++i) {
+      const double x = state.u(dofs_[i]) / 1e-9;
+      r(static_cast<Eigen::Index>(i)) = amplitude_ * (1.0 - 4.0 * std::abs(x - std::floor(x) - 0.5));
+    }
+    out.add(dofs_, r, Eigen::MatrixXd::Zero(r.size(), r.size()));
+  }
+
+ private:
+  std::vector<GlobalDof> dofs_;
+  double amplitude_;
+  bool unsettled_;
+};
+
+TEST(SolverNewton, ResidualFloorIsTakenAsConvergedOnlyWhenSmallAgainstTheForcesAndSettled) {
+  auto solve = [](double amplitude, double floor_tolerance, Eigen::VectorXd& u, bool unsettled = false) {
+    auto b = make_neo_hooke_block(box_hex8(2, 2, 4, 1.0, 1.0, 2.0));
+    b->model.add_term<RobinSprings>("springs", *b->body, b->bottom, 100.0);
+    b->model.add_term<FollowerPressure>("pressure", *b->body, b->top, 0.1, LoadCurve::ramp(0, 1));
+    std::vector<GlobalDof> top;
+    for (std::size_t i = 0; i < b->body->num_nodes(); ++i)
+      if (b->body->mesh().points[i].z() > 2 - 1e-9) top.push_back(b->body->dof(i, 2));
+    if (amplitude > 0.0) b->model.add_term<ResidualFloorTerm>(top, amplitude, unsettled);
+    b->model.size_constraints();
+    GlobalSystem sys(b->model.constraints);
+    auto linear = make_linear_solver({});
+    u = Eigen::VectorXd::Zero(b->model.dofs.size());
+    NewtonSettings ns;
+    ns.residual_tolerance = 1e-12;
+    ns.residual_absolute = 0.0;
+    ns.increment_tolerance = 1e-12;
+    ns.floor_tolerance = floor_tolerance;
+    return newton_step(b->model, sys, *linear, u, 1.0, 1.0, ns);
+  };
+  Eigen::VectorXd clean, u;
+  const double floor_tolerance = NewtonSettings{}.floor_tolerance;
+  const NewtonResult smooth = solve(0.0, floor_tolerance, clean);
+  ASSERT_TRUE(smooth.converged) << smooth.failure;
+  EXPECT_FALSE(smooth.at_floor);  // a smooth model converges by its tolerances
+  const double forces = smooth.force_magnitude;
+  ASSERT_GT(forces, 0.0);
+  // The wave's residual norm is about its amplitude times sqrt(9 nodes / 3) (mean square of a triangle wave).
+  const double amplitude = 1e-2 * floor_tolerance * forces;
+  const NewtonResult floored = solve(amplitude, floor_tolerance, u);
+  ASSERT_TRUE(floored.converged) << floored.failure;
+  EXPECT_TRUE(floored.at_floor);
+  EXPECT_LT(floored.iterations, 12);
+  std::printf("floor: |R| = %.2e of forces %.2e after %d iterations, |u - u_smooth| = %.2e of |u| %.2e\n",
+              floored.residual_norms.back(), forces, floored.iterations, (u - clean).norm(), clean.norm());
+  EXPECT_GT(floored.residual_norms.back(), 1e-12 * forces);  // above the residual tolerance: the floor test decided
+  EXPECT_LT((u - clean).norm(), floor_tolerance * clean.norm());
+  // Without the floor test, and with a floor above its tolerance, the step does not converge.
+  EXPECT_FALSE(solve(amplitude, 0.0, u).converged);
+  EXPECT_FALSE(solve(10.0 * floor_tolerance * forces, floor_tolerance, u).converged);
+  // ... and while an active set keeps changing, the state is on its way, not at a floor.
+  EXPECT_FALSE(solve(amplitude, floor_tolerance, u, true).converged);
+}
+
 // Prescribed homogeneous deformation on the boundary of a distorted tet10
 // patch: the solver reproduces it at the interior nodes.
 TEST(SolverNewton, PatchTestThroughSolver) {
