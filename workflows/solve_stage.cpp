@@ -239,6 +239,24 @@ std::string qois(const CaseConfig& c, const Phases& ph) {
         fmt::arg("media", static_cast<int>(tags::media)), fmt::arg("adv", static_cast<int>(tags::adventitia)),
         fmt::arg("endo", selector(tags::endothelium)), fmt::arg("times", ph.times()),
         fmt::arg("intima", ph.patient ? fmt::format("intima: {}, ", static_cast<int>(tags::intima)) : ""));
+  if (ph.artery)
+    y += fmt::format(
+        "  - name: malapposition\n"
+        "    type: malapposition            # strut-to-endothelium gaps; malapposed above the strut thickness (DESIGN.md §8)\n"
+        "    body: stent\n"
+        "    solid: artery\n"
+        "    surface: {endo}\n"
+        "    times: {times}\n",
+        fmt::arg("endo", selector(tags::endothelium)), fmt::arg("times", ph.times()));
+  if (ph.artery)
+    y += fmt::format(
+        "  - name: lumen\n"
+        "    type: lumen_area               # cross-section areas in the planes of the stent's rings and between them\n"
+        "    stent: stent\n"
+        "    body: artery\n"
+        "    surface: {endo}\n"
+        "    times: {times}\n",
+        fmt::arg("endo", selector(tags::endothelium)), fmt::arg("times", ph.times()));
   return y;
 }
 

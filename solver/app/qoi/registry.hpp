@@ -12,5 +12,7 @@ QoiKind ring_expansion_qoi();
 QoiKind stent_expansion_qoi();
 QoiKind balloon_profile_qoi();
 QoiKind layer_stresses_qoi();
+QoiKind malapposition_qoi();
+QoiKind lumen_area_qoi();
 
 }  // namespace stentsim::solver

@@ -47,14 +47,8 @@ class StentExpansion : public RunObserver {
       throw InputError(fmt::format("{}: qoi '{}': body '{}' ({}) has no ring membership (the stent stage's MemberKind and "
                                    "Ring cell arrays); stent_expansion needs a stent file",
                                    spec.where, spec.name, spec.body, desc.source));
-    std::map<int, std::set<int>> rings;
-    for (std::size_t e = 0; e < desc.body.elements.size(); ++e)
-      if (desc.element_ring[e] >= 0) {
-        const auto& el = desc.body.elements[e];
-        rings[desc.element_ring[e]].insert(el.a), rings[desc.element_ring[e]].insert(el.b);
-      }
-    if (rings.empty()) throw InputError(fmt::format("{}: qoi '{}': body '{}' has no strut elements", spec.where, spec.name, spec.body));
-    for (auto& [k, nodes] : rings) ring_nodes_.emplace_back(nodes.begin(), nodes.end());
+    ring_nodes_ = stent_ring_nodes(desc);
+    if (ring_nodes_.empty()) throw InputError(fmt::format("{}: qoi '{}': body '{}' has no strut elements", spec.where, spec.name, spec.body));
     if (!spec.pressure.empty()) {
       for (const auto& [name, p] : m.pressures)
         if (name == spec.pressure) pressure_ = p;
