@@ -41,6 +41,8 @@ class GlobalSystem : public Assembler {
   /// magnitudes of every contribution c (element, contact point, load) to DOF d. At
   /// equilibrium the residual cancels them; |R| / |m| says how far from complete that is.
   double force_magnitude_norm() const;
+  /// m itself (local coordinates, all DOFs; summed over ranks).
+  const Eigen::VectorXd& force_magnitudes() const { return magnitude_; }
   /// Right-hand side of K du = rhs: -(R + K_fc du_c) at free DOFs, du_c at fixed ones.
   Eigen::VectorXd rhs() const;
   const CsrMatrix& matrix() const { return matrix_; }

@@ -33,6 +33,16 @@ struct SurfaceFace {
   std::size_t cell = 0;       // the volume cell of the body it bounds
 };
 
+/// A face as linear triangles of its surface-local nodes, outward like the face: a quad4 as
+/// two, a tri6 as four through its mid-side nodes (VTK order), for measures that need flat
+/// pieces (distances, plane cuts).
+inline std::vector<std::array<int, 3>> linear_triangles(const SurfaceFace& f) {
+  const auto& n = f.node;
+  if (f.kind == FaceKind::quad4) return {{n[0], n[1], n[2]}, {n[0], n[2], n[3]}};
+  if (f.kind == FaceKind::tri3) return {{n[0], n[1], n[2]}};
+  return {{n[0], n[3], n[5]}, {n[3], n[1], n[4]}, {n[5], n[4], n[2]}, {n[3], n[4], n[5]}};
+}
+
 /// d n_I / d(positions of its patch): the patch's surface-local nodes, the
 /// 3 x 3m Jacobian (columns node-major) and the three 3m x 3m Hessians.
 struct NormalDerivatives {

@@ -41,8 +41,6 @@
 namespace stentsim::solver {
 namespace {
 
-using contact::FaceKind;
-
 class LumenAreaSpec : public QoiSpec {
  public:
   std::string stent;
@@ -87,12 +85,8 @@ class LumenArea : public RunObserver {
       if (k > 0) add(0.5 * (measured[k - 1].centroid + measured[k].centroid), measured[k - 1].axis + measured[k].axis);
       add(measured[k].centroid, measured[k].axis);
     }
-    for (const auto& f : surface_.faces()) {
-      const auto& v = f.node;
-      if (f.kind == FaceKind::quad4) cells_.push_back({v[0], v[1], v[2], v[3]});
-      else if (f.kind == FaceKind::tri3) cells_.push_back({v[0], v[1], v[2]});
-      else for (auto t : {std::vector<int>{v[0], v[3], v[5]}, {v[3], v[1], v[4]}, {v[5], v[4], v[2]}, {v[3], v[4], v[5]}}) cells_.push_back(t);
-    }
+    for (const auto& f : surface_.faces())
+      for (const auto& t : contact::linear_triangles(f)) cells_.push_back(t);
   }
 
   void start(const Eigen::VectorXd& u, bool restarted) override {
@@ -140,8 +134,7 @@ class LumenArea : public RunObserver {
     surface_.update(u);
     MeshData mesh;
     for (std::size_t i = 0; i < surface_.num_nodes(); ++i) mesh.points.push_back(surface_.x(static_cast<int>(i)));
-    for (const auto& c : cells_)
-      mesh.add_cell(c.size() == 4 ? CellType::quad : CellType::triangle, std::vector<std::int64_t>(c.begin(), c.end()));
+    for (const auto& c : cells_) mesh.add_cell(CellType::triangle, std::vector<std::int64_t>(c.begin(), c.end()));
     std::vector<double> areas;
     int open = 0;
     for (const Station& st : stations_) {
@@ -175,7 +168,7 @@ class LumenArea : public RunObserver {
   mutable contact::ContactSurface surface_;
   double t_end_;
   std::vector<Station> stations_;
-  std::vector<std::vector<int>> cells_;  // linear triangles and quads of the surface, surface-local nodes
+  std::vector<std::array<int, 3>> cells_;  // the surface's linear triangles, surface-local nodes
   std::map<std::string, std::vector<double>> at_;
 };
 

@@ -27,6 +27,7 @@
 #include <limits>
 
 #include "common/error.hpp"
+#include "common/triangle_distance.hpp"
 #include "solver/app/body_surfaces.hpp"
 #include "solver/app/built_model.hpp"
 #include "solver/app/qoi/registry.hpp"
@@ -38,38 +39,6 @@
 
 namespace stentsim::solver {
 namespace {
-
-using contact::FaceKind;
-
-/// Closest point to p on the triangle (a, b, c), by the region of p's projection
-/// (vertex, edge or interior) in barycentric terms.
-Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
-/// Linear triangles of a face (surface-local nodes, outward order).
-std::vector<std::array<int, 3>> face_triangles(const contact::SurfaceFace& f) {
-  const auto& n = f.node;
-  if (f.kind == FaceKind::quad4) return {{n[0], n[1], n[2]}, {n[0], n[2], n[3]}};
-  if (f.kind == FaceKind::tri3) return {{n[0], n[1], n[2]}};
-  return {{n[0], n[3], n[5]}, {n[3], n[1], n[4]}, {n[5], n[4], n[2]}, {n[3], n[4], n[5]}};  // tri6: VTK mid-side order
-}
 
 class MalappositionSpec : public QoiSpec {
  public:
@@ -156,17 +125,27 @@ class Malapposition : public RunObserver {
     start_ = std::max(1e-3 * reach_, 4.0 * radius_);
   }
   /// Signed distance of p to the current surface: positive on the side its normals point to.
+  /// The side is judged by the averaged nodal normals interpolated at the closest point (its
+  /// barycentric coordinates), the same on both triangles of an edge, so a closest point on an
+  /// edge or a vertex of a dent or a bend gets one answer whichever triangle holds it.
   double signed_distance(const Vec3& p) const {
     std::vector<int> faces;
     for (double r = start_;; r *= 2.0) {
       grid_.query(p.array() - r, p.array() + r, faces);
       double best = std::numeric_limits<double>::infinity(), sign = 1.0;
       for (int fi : faces)
-        for (const auto& t : face_triangles(surface_.faces()[static_cast<std::size_t>(fi)])) {
+        for (const auto& t : contact::linear_triangles(surface_.faces()[static_cast<std::size_t>(fi)])) {
           const Vec3 &a = surface_.x(t[0]), &b = surface_.x(t[1]), &c = surface_.x(t[2]);
           const Vec3 q = closest_on_triangle(p, a, b, c);
           const double d = (p - q).norm();
-          if (d < best) best = d, sign = (p - q).dot((b - a).cross(c - a)) >= 0.0 ? 1.0 : -1.0;
+          if (!(d < best)) continue;
+          best = d;
+          const Vec3 e0 = b - a, e1 = c - a, e2 = q - a;
+          const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1), d20 = e2.dot(e0), d21 = e2.dot(e1);
+          const double den = d00 * d11 - d01 * d01;
+          const double lb = den > 0 ? (d11 * d20 - d01 * d21) / den : 1.0 / 3, lc = den > 0 ? (d00 * d21 - d01 * d20) / den : 1.0 / 3;
+          const Vec3 n = (1 - lb - lc) * surface_.normal(t[0]) + lb * surface_.normal(t[1]) + lc * surface_.normal(t[2]);
+          sign = (p - q).dot(n) >= 0.0 ? 1.0 : -1.0;
         }
       // Every face within r of p overlaps the box: a nearest face at most r away is the nearest of all.
       if (best <= r || r > 2.0 * reach_) return sign * best;
