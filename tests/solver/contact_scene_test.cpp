@@ -117,6 +117,7 @@ TEST(ContactScene, RingIsExpandedByTheBalloonAloneAndPenaltyActsAsExpected) {
   std::printf("lumen area: %.4f (initial, 29-gon %.4f), %.4f (max, inside the ring %.4f), %.4f mm^2 (after)\n",
               qoi(a, "lumen_area_min_initial"), a0, qoi(a, "lumen_area_min_max"), a_max, qoi(a, "lumen_area_min_after"));
   EXPECT_EQ(qoi(a, "lumen_area_stations"), 1.0);  // one ring: one plane
+  EXPECT_EQ(qoi(a, "lumen_area_open_stations_max"), 0.0);
   EXPECT_NEAR(qoi(a, "lumen_area_min_initial"), a0, 2e-3 * a0);
   EXPECT_NEAR(qoi(a, "lumen_area_min_max"), a_max, 0.02 * a_max);
   EXPECT_NEAR(qoi(a, "lumen_area_min_after"), a0, 0.05 * a0);

@@ -8,7 +8,8 @@
 // (plane_section.hpp) and `rays` rays from the station's centre find the nearest
 // wall; the area is that of the polygon through the hits, so a cut of another
 // part of the vessel farther out does not count. A station where a ray meets no
-// wall (the plane leaves the vessel) has no area and is left out. At each labelled
+// wall (the plane leaves the vessel, or the lumen moved off the centre) has no area,
+// is left out with a warning and counted (lumen_area_open_stations_<label>). At each labelled
 // time and initially: lumen_area_min_<label> (mm²), its position along the
 // stations (lumen_area_min_position_<label>, mm from the first), the mean
 // (lumen_area_mean_<label>) and the areas of the stations that cut a closed lumen
@@ -116,6 +117,7 @@ class LumenArea : public RunObserver {
         sum += areas[k];
         if (areas[k] < lo) lo = areas[k], where = stations_[k].position;
       }
+      s.set("lumen_area_open_stations_" + label, static_cast<double>(areas.size() - closed.size()));
       if (closed.empty()) {
         s.note("lumen_area_" + label, "no station's plane cuts a closed lumen");
         continue;
@@ -160,7 +162,9 @@ class LumenArea : public RunObserver {
       }
       areas.push_back(area);
     }
-    if (open > 0) log::debug("qoi '{}': {} of {} stations cut no closed lumen", spec_.name, open, stations_.size());
+    if (open > 0)
+      log::warn("qoi '{}': {} of {} stations cut no closed lumen around their centre (left out of the areas)", spec_.name, open,
+                stations_.size());
     return areas;
   }
 
