@@ -55,7 +55,11 @@ std::string residual_by_owner(const Model& model, const Eigen::VectorXd& r) {
 bool within_floor(const Model& model, const GlobalSystem& system, double tolerance, double bound) {
   const std::vector<double> r = norms_by_owner(model, system.residual()), m = norms_by_owner(model, system.force_magnitudes());
   for (std::size_t k = 0; k < r.size(); ++k)
-    if (r[k] > tolerance * m[k] && r[k] > bound) return false;
+    if (r[k] > tolerance * m[k] && r[k] > bound) {
+      log::debug("  not at a residual floor: '{}' has |R| = {:.3e} against forces in balance {:.3e}", model.dofs.ranges()[k].owner,
+                 r[k], m[k]);
+      return false;
+    }
   return true;
 }
 }  // namespace
