@@ -70,7 +70,7 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
     const GlobalDof gi = dofs[static_cast<std::size_t>(i)];
     if (gi < 0) continue;
     residual_(gi) += rv(i);
-    magnitude_(gi) += std::abs(rv(i));
+    if (with_tangent_) magnitude_(gi) += std::abs(rv(i));
     if (!tangent || constraints_.fixed(gi)) continue;
     for (Eigen::Index j = 0; j < n; ++j) {
       const GlobalDof gj = dofs[static_cast<std::size_t>(j)];
@@ -88,7 +88,7 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
 void GlobalSystem::finish() {
   if (ranks_ > 1) {
     parallel::sum(residual_);
-    parallel::sum(magnitude_);
+    if (with_tangent_) parallel::sum(magnitude_);
     if (with_tangent_) parallel::sum(correction_);
   }
   if (!with_tangent_) return;

@@ -40,6 +40,8 @@ class GlobalSystem : public Assembler {
   /// Size of the forces in balance: the norm over free DOFs of m_d = Σ_c |r_c,d|, the
   /// magnitudes of every contribution c (element, contact point, load) to DOF d. At
   /// equilibrium the residual cancels them; |R| / |m| says how far from complete that is.
+  /// Assembled with the tangent only (Newton judges accepted states, which always have one;
+  /// the line search's residual-only trials skip it); zero after a residual-only assembly.
   double force_magnitude_norm() const;
   /// m itself (local coordinates, all DOFs; summed over ranks).
   const Eigen::VectorXd& force_magnitudes() const { return magnitude_; }

@@ -36,10 +36,10 @@
 // (Term::accepted_changes: while contact points still enter or leave, the state is
 // on its way, not at a floor) is taken as converged at that floor
 // (NewtonResult::at_floor, counted and reported), instead of being cut: smaller
-// steps do not lower a floor that the model's geometry sets. The bound 1e-6 sits
-// above the patient example's floors (|R| about 5e-7 N against forces in balance of
-// about 15 N) and far below the residual tests of general-purpose codes (Abaqus:
-// 5e-3 of the average nodal force). The state at the floor may still differ from the
+// steps do not lower a floor that the model's geometry sets. The default bound 1e-6
+// is far below the residual tests of general-purpose codes (Abaqus: 5e-3 of the
+// average nodal force); a scene whose floor lies in a soft body with small forces of
+// its own sets a larger one (the case's solve scene: 1e-4, workflows/solve_stage.cpp). The state at the floor may still differ from the
 // exact one in soft modes (the balloon's sliding), which carry little energy.
 #include <Eigen/Core>
 

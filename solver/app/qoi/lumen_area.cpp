@@ -75,7 +75,8 @@ class LumenArea : public RunObserver {
     std::vector<Vec3> radial;
     for (std::size_t k = 0; k < rings.size(); ++k)
       for (int nd : rings[k]) pts[k].push_back(beam.position(zero, nd));
-    for (int nd : rings[0]) radial.push_back(beam.rotation(nd).toRotationMatrix().col(1));  // stent file: the outward director
+    if (rings.size() == 1)
+      for (int nd : rings[0]) radial.push_back(beam.rotation(nd).toRotationMatrix().col(1));  // stent file: the outward director
     const auto measured = measure_rings(pts, rings.size() == 1 ? axis_normal_to(radial) : Vec3::UnitZ());
     auto add = [&](const Vec3& c, Vec3 t) {
       t.normalize();
