@@ -71,16 +71,30 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
     if (gi < 0) continue;
     residual_(gi) += rv(i);
     if (with_tangent_) magnitude_(gi) += std::abs(rv(i));
-    if (!tangent || constraints_.fixed(gi)) continue;
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const GlobalDof gj = dofs[static_cast<std::size_t>(j)];
-      if (gj < 0) continue;
-      const double v = kv(i, j);
-      if (constraints_.fixed(gj)) {
-        correction_(gi) += v * prescribed_(gj);
-        continue;
-      }
-      insert(gi, gj, v);
+  }
+  if (!tangent) return;
+  // The block's free columns in DOF order, so that each row is one forward walk
+  // through its sorted CSR columns (a node's x, y, z are neighbours there)
+  // instead of a binary search per entry; fixed columns go to the correction.
+  free_cols_.clear();
+  fixed_cols_.clear();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const GlobalDof gj = dofs[static_cast<std::size_t>(j)];
+    if (gj < 0) continue;
+    (constraints_.fixed(gj) ? fixed_cols_ : free_cols_).emplace_back(gj, j);
+  }
+  std::sort(free_cols_.begin(), free_cols_.end());
+  const std::int64_t* cols = matrix_.cols.data();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const GlobalDof gi = dofs[static_cast<std::size_t>(i)];
+    if (gi < 0 || constraints_.fixed(gi)) continue;
+    for (const auto& [gj, j] : fixed_cols_) correction_(gi) += kv(i, j) * prescribed_(gj);
+    std::int64_t pos = matrix_.row_ptr[static_cast<std::size_t>(gi)];
+    const std::int64_t end = matrix_.row_ptr[static_cast<std::size_t>(gi) + 1];
+    for (const auto& [gj, j] : free_cols_) {
+      if (pos < end && cols[pos] < gj && (++pos < end && cols[pos] < gj)) pos = std::lower_bound(cols + pos, cols + end, gj) - cols;
+      if (pos < end && cols[pos] == gj) matrix_.values[static_cast<std::size_t>(pos)] += kv(i, j);
+      else pending_.emplace_back(gi, gj, kv(i, j));
     }
   }
 }

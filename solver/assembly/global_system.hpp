@@ -9,6 +9,7 @@
 // a new coupling (contact).
 #include <Eigen/Core>
 
+#include <utility>
 #include <vector>
 
 #include "solver/assembly/constraints.hpp"
@@ -61,6 +62,7 @@ class GlobalSystem : public Assembler {
   // scratch for frame rotations (grows, never shrinks: no per-element allocation)
   Eigen::VectorXd r_scratch_;
   Eigen::MatrixXd k_scratch_;
+  std::vector<std::pair<GlobalDof, Eigen::Index>> free_cols_, fixed_cols_;  // add()'s columns: (DOF, local index)
 };
 
 }  // namespace stentsim::solver
