@@ -31,9 +31,10 @@
 // error that falls with n; see tests/solver/contact_surface_to_surface_test.cpp).
 //
 // Search: once per step (begin_step), each slave face collects the master faces
-// whose boxes lie within the margin of its own box (face_search.hpp); those
-// pairs reserve their matrix pattern once after each search; the search is
-// redone when a slave or master node moved more than half the margin since.
+// whose boxes lie within the margin of its own box (face_search.hpp); the search
+// is redone when a slave or master node moved more than half the margin since.
+// A slave node reserves its matrix block over the master faces its Gauss points
+// hit within the margin (before it is active), not over all the candidates.
 // Active-set chattering (a node that flips more than `max_flips` times in one
 // step, counted between accepted Newton iterates: active_set.hpp) fails the
 // iteration (ElementFailure) so the step is cut.
@@ -142,8 +143,13 @@ class SurfaceToSurfacePair : public Term {
   void search(const ContactSurface& slave, const ContactSurface& master, Candidates& out) const;
   void refresh_search();
   bool moved_too_far() const;
+  /// Projects the Gauss points of slave face `face` (gap and hit master face
+  /// only); point_gap_derivatives adds their derivatives (1: gradient, 2: and
+  /// Hessian), which are needed only around active slave nodes.
   void point_gaps(const ContactSurface& slave, const ContactSurface& master, const Candidates& cand, int face,
-                  int derivatives, std::vector<PointGap>& out) const;
+                  std::vector<PointGap>& out) const;
+  void point_gap_derivatives(const ContactSurface& slave, const ContactSurface& master, int face, int derivatives,
+                             std::vector<PointGap>& points) const;
   /// Adds node j's residual (and tangent) at the current surfaces to `out`; returns the weighted gap.
   struct NodeResult {
     double weighted_gap = 0.0, covered = 0.0;
@@ -151,8 +157,8 @@ class SurfaceToSurfacePair : public Term {
   };
   NodeResult assemble_node(const ContactSurface& slave, const ContactSurface& master, int j,
                            const std::vector<std::vector<PointGap>>& gaps, bool tangent, Assembler* out) const;
-  /// DOFs of node j's candidate pairs (pattern reservation).
-  std::vector<GlobalDof> candidate_dofs(int j) const;
+  /// DOFs of node j's block against `master_faces` (pattern reservation).
+  std::vector<GlobalDof> block_dofs(int j, const std::vector<int>& master_faces) const;
 
   std::string name_;
   std::unique_ptr<ContactSurface> slave_, master_;
@@ -162,8 +168,7 @@ class SurfaceToSurfacePair : public Term {
   std::vector<double> area_;                    // A_j per slave node
   Candidates candidates_;
   std::vector<Vec3> searched_slave_, searched_master_;
-  bool pattern_reserved_ = false;
-  Candidates reserved_;  // per slave node, the master faces of the block reserved last (sorted)
+  Candidates reserved_;  // per slave node, the master faces its reserved blocks cover (sorted)
   ActiveSet active_;  // per slave node
   int accepted_changes_ = 0;  // nodes the last accept() switched
   long long searches_ = 0;
