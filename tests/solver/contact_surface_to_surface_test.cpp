@@ -13,6 +13,8 @@
 
 #include <Eigen/QR>
 
+#include "solver/assembly/constraints.hpp"
+#include "solver/assembly/global_system.hpp"
 #include "solver/contact/surface_to_surface_pair.hpp"
 #include "solver/fem/boundary_faces.hpp"
 #include "solver/io/generated_meshes.hpp"
@@ -161,6 +163,48 @@ void fd_tangent_check(MasterKind kind, int gauss) {
 
 TEST(SolverContactS2S, TangentMatchesFiniteDifferencesTri6Master) { fd_tangent_check(MasterKind::tri6, 4); }
 TEST(SolverContactS2S, TangentMatchesFiniteDifferencesQuad4Master) { fd_tangent_check(MasterKind::quad4, 3); }
+
+// The matrix pattern a slave node reserves couples it to the master faces its
+// Gauss points hit, not to every candidate of the search: a flat 1 x 1 slave
+// plate over a 2.8 x 2.8 master with a search margin of 0.6 has candidate faces
+// out to |x| = 1.2, but its points (straight down) hit only |x|, |y| <= 0.7.
+TEST(SolverContactS2S, ReservesTheBlocksOfHitMasterFacesOnly) {
+  MeshData ms = box_hex8(4, 4, 1, 1.0, 1.0, 0.2);
+  for (auto& p : ms.points) p.x() -= 0.5, p.y() -= 0.5, p.z() += 0.01;  // 0.01 above the master
+  MeshData mm = box_hex8(8, 8, 1, 2.8, 2.8, 0.3);
+  for (auto& p : mm.points) p.x() -= 1.4, p.y() -= 1.4, p.z() -= 0.3;
+  const SolidBody slave_body(solid_spec("slave", ms), 0);
+  const SolidBody master_body(solid_spec("master", mm), slave_body.num_dofs());
+  const GlobalDof n = slave_body.num_dofs() + master_body.num_dofs();
+  auto slave = std::make_unique<ContactSurface>("balloon", slave_body, faces_where(slave_body, [](const Vec3& p) { return p.z() < 0.02; }));
+  auto master = std::make_unique<ContactSurface>("endothelium", master_body, faces_where(master_body, [](const Vec3& p) { return p.z() > -1e-9; }));
+  SurfaceToSurfaceSettings set;
+  set.law.epsilon = 5.0;
+  set.search_margin = 0.6;
+  SurfaceToSurfacePair pair("s2s", std::move(slave), std::move(master), set);
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+  pair.begin_step(SystemState{u});
+  Constraints constraints(n);
+  GlobalSystem system(constraints);
+  system.begin(u, true);
+  pair.assemble(SystemState{u}, system);
+  system.finish();
+  const CsrMatrix& k = system.matrix();
+  int hit_columns = 0, far_columns = 0;
+  for (std::size_t i = 0; i < pair.slave().num_nodes(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const auto row = static_cast<std::size_t>(pair.slave().dof(static_cast<int>(i), c));
+      for (auto e = k.row_ptr[row]; e < k.row_ptr[row + 1]; ++e) {
+        const GlobalDof col = k.cols[static_cast<std::size_t>(e)];
+        if (col < slave_body.num_dofs()) continue;
+        const Vec3& x = mm.points[static_cast<std::size_t>((col - slave_body.num_dofs()) / 3)];
+        (std::max(std::abs(x.x()), std::abs(x.y())) <= 0.7 + 1e-9 ? hit_columns : far_columns) += 1;
+      }
+    }
+  std::printf("slave rows: %d entries in master columns under the slave, %d beyond it\n", hit_columns, far_columns);
+  EXPECT_GT(hit_columns, 0);
+  EXPECT_EQ(far_columns, 0);
+}
 
 // ---------------------------------------------------------------------------
 // 2. Contact patch test: two unit blocks, laterally on rollers (uniform stress),
