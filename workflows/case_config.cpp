@@ -147,8 +147,10 @@ CaseConfig load_case(const std::filesystem::path& file) {
   c.fibers = parse_fibers(top.map("fibers"));
   c.simulation = parse_simulation(top.map("simulation"));
   c.output = parse_output(top.map("output"));
-  if (top.has("stenosis") && c.scene != Scene::patient)
-    top.fail("stenosis", "a " + std::string(to_string(c.scene)) + " scene has no lumen to find lesions in; remove this section");
+  c.placed = c.scene == Scene::patient || (c.scene == Scene::free_expansion && top.has("input"));
+  if (top.has("stenosis") && !c.placed)
+    top.fail("stenosis", "a " + std::string(to_string(c.scene)) + " scene without an input has no lumen to find lesions in; "
+                         "remove this section");
   {
     auto st = top.map("stenosis");
     c.stenosis = parse_stenosis_rule(st);

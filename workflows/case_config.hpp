@@ -73,6 +73,10 @@ struct CaseConfig {
   /// region of interest and wall synthesis, the centerline stage's lesions
   /// and the placement's site.
   StenosisRule stenosis;
+  /// The device is warped along a placement's balloon centerline (DESIGN.md §3):
+  /// a patient, or a free expansion given a vessel (`input:`) whose centerline
+  /// it follows, as the paper's curved device (Section 3.2).
+  bool placed = false;
 
   /// The raw YAML of a section ("device.stent"); an empty map when absent.
   YAML::Node section(const std::string& dotted) const;

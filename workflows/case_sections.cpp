@@ -7,11 +7,11 @@
 namespace stentsim::workflows {
 
 void validate_stage_sections(const CaseConfig& c, ConfigMap& top) {
-  if (c.scene != Scene::patient) {
-    if (top.has("input"))
-      top.fail("input", "a " + std::string(to_string(c.scene)) + " scene has no artery input; remove this section");
+  if (c.scene == Scene::generic_artery && top.has("input"))
+    top.fail("input", "a generic-artery scene has no artery input (its artery is the paper's straight tube); remove this section");
+  if (!c.placed) {
     if (top.has("centerline"))
-      top.fail("centerline", "a " + std::string(to_string(c.scene)) + " scene has no lumen centerline; remove this section");
+      top.fail("centerline", "a " + std::string(to_string(c.scene)) + " scene without an input has no lumen centerline; remove this section");
   } else {
     if (!top.has("input")) top.fail("input", "a patient scene needs an input section (e.g. input: {phantom: {preset: case2-rca}})");
     auto input = top.map("input");
@@ -24,11 +24,12 @@ void validate_stage_sections(const CaseConfig& c, ConfigMap& top) {
   device_gen::parse_balloon_design(balloon);
   auto stent = device.map("stent");
   device_gen::parse_stent_design(stent);
-  if (c.scene == Scene::patient) {
+  if (c.placed) {
     auto placement = device.map("placement");
     device_gen::parse_placement_params(placement);
   } else if (device.has("placement")) {
-    device.fail("placement", "only a patient scene places the device along a centerline; remove this section");
+    device.fail("placement", "only a patient scene or a free expansion with an input places the device along a centerline; "
+                             "remove this section");
   }
   device.finish();
 }

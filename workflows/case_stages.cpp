@@ -183,12 +183,12 @@ Stage placement_stage(const CaseConfig& c) {
   return s;
 }
 
-/// Balloon or stent: along the placement's balloon centerline in a patient,
-/// straight along +z otherwise (DESIGN.md §3).
+/// Balloon or stent: along the placement's balloon centerline in a patient or
+/// a curved free expansion, straight along +z otherwise (DESIGN.md §3).
 Stage device_stage(const CaseConfig& c, const std::string& name) {
   Stage s;
   s.name = name;
-  const bool placed = c.scene == Scene::patient;
+  const bool placed = c.placed;
   if (placed) s.inputs = {"placement/placement.yaml"};
   s.outputs = {name + "/" + name + ".vtu"};
   s.config = slice(c, {name == "balloon" ? "device.balloon" : "device.stent"});
@@ -216,6 +216,11 @@ std::vector<pipeline::Stage> stages_for(const CaseConfig& c) {
   std::vector<pipeline::Stage> stages;
   switch (c.scene) {
     case Scene::free_expansion:
+      if (c.placed) {  // the curved device: along the input vessel's centerline, no artery
+        stages.push_back(segmentation_stage(c));
+        stages.push_back(centerline_stage(c));
+        stages.push_back(placement_stage(c));
+      }
       stages.push_back(device_stage(c, "balloon"));
       stages.push_back(device_stage(c, "stent"));
       break;

@@ -13,7 +13,7 @@ namespace {
 /// The entry of the paper's numbers (targets.yaml) that this case reproduces, if any.
 std::string targets_key(const CaseConfig& c) {
   switch (c.scene) {
-    case Scene::free_expansion: return "free_expansion_straight";
+    case Scene::free_expansion: return c.placed ? "free_expansion_curved" : "free_expansion_straight";
     case Scene::generic_artery: return "generic_artery_case1";
     case Scene::patient: return "patient_case2";
   }

@@ -37,7 +37,8 @@ struct Artifacts {
 /// "after" are the ends of the phases.
 struct Phases {
   bool artery;
-  bool patient;  // segmented three-layer artery, device warped along the placement's centerline
+  bool patient;  // segmented three-layer artery
+  bool placed;   // device warped along the placement's centerline (patient, curved free expansion)
   double T;
   double prestress() const { return artery ? T : 0.0; }
   double max() const { return prestress() + T; }
@@ -74,6 +75,8 @@ std::string header(const CaseConfig& c, const Phases& ph) {
                                      "stent–artery beam-to-surface, balloon–artery surface-to-surface contact."
                        : ph.artery ? "Generic artery (paper 4.1): artery (media, adventitia) with fibers, balloon, stent; "
                                      "stent–balloon and stent–artery beam-to-surface, balloon–artery surface-to-surface contact."
+                       : ph.placed ? "Curved free expansion (paper 3.2): balloon + stent warped along the placement's centerline, "
+                                     "no artery; stent–balloon beam-to-surface contact."
                                    : "Free expansion (paper 3.1): balloon + stent, stent–balloon beam-to-surface contact."),
       fmt::arg("phases", ph.artery ? fmt::format("prestress to t {:g} (diastolic pressure, held), inflation to t {:g} (\"max\"), "
                                                  "deflation to t {:g} (\"after\")",
@@ -93,7 +96,7 @@ std::string bodies(const CaseConfig& c, const Artifacts& a, const Phases& ph) {
       "  - name: stent\n"
       "    beam: {{file: {st}, material: stent, joints: rigid}}   # App. C elasto-plastic beams\n",
       fmt::arg("b", quoted(a.balloon)), fmt::arg("st", quoted(a.stent)),
-      fmt::arg("frames", ph.patient ? fmt::format("    fiber_frames:                # warped balloon: the balloon stage's frames per cell; "
+      fmt::arg("frames", ph.placed ? fmt::format("    fiber_frames:                # warped balloon: the balloon stage's frames per cell; "
                                                   "fibers from the material's angles\n"
                                                   "      {{file: {}, fibers: none}}\n",
                                                   quoted(a.balloon))
@@ -221,7 +224,7 @@ std::string qois(const CaseConfig& c, const Phases& ph) {
       "    times: {times}\n",
       fmt::arg("times", ph.times()));
   // The balloon's profile along its axis needs a straight balloon.
-  if (!ph.patient)
+  if (!ph.placed)
     y += fmt::format(
       "  - name: balloon\n"
       "    type: balloon_profile          # outer diameter along the (straight) axis\n"
@@ -266,7 +269,7 @@ std::string qois(const CaseConfig& c, const Phases& ph) {
 }
 
 Phases phases(const CaseConfig& c) {
-  return {c.scene != Scene::free_expansion, c.scene == Scene::patient, c.simulation.phase_duration};
+  return {c.scene != Scene::free_expansion, c.scene == Scene::patient, c.placed, c.simulation.phase_duration};
 }
 
 /// The comments and description (the case's name and file: not physics).

@@ -42,6 +42,15 @@ TEST(CaseConfig, EveryExampleLoadsAndValidates) {
     EXPECT_EQ(c.work_dir, (dir / (std::string(scene) + ".work")).lexically_normal());
     EXPECT_THROW(write_example_case(dir, scene), InputError);  // never overwrites
   }
+  EXPECT_FALSE(load_case(dir / "free-expansion.yaml").placed);
+  // The curved free expansion: a free-expansion scene whose device is placed along its input's centerline.
+  const auto curved = load_case(write_example_case(dir, "free-expansion-curved"));
+  EXPECT_EQ(curved.scene, Scene::free_expansion);
+  EXPECT_TRUE(curved.placed);
+  EXPECT_DOUBLE_EQ(curved.simulation.balloon_end_springs, 1000.0);
+  std::vector<std::string> plan;
+  for (const auto& st : stages_for(curved)) plan.push_back(st.name);
+  EXPECT_EQ(plan, (std::vector<std::string>{"segmentation", "centerline", "placement", "balloon", "stent", "solve", "report"}));
   const auto c = load_case(dir / "patient.yaml");
   EXPECT_NEAR(c.simulation.diastolic_pressure, 85 * 133.322387415e-6, 1e-15);
   EXPECT_DOUBLE_EQ(c.simulation.pressure_max, 1.01);
@@ -79,7 +88,7 @@ TEST(CaseConfig, BadFilesGiveErrorsThatNameFileLineKeyAndExpectation) {
   EXPECT_NE(msg.find("out of range"), std::string::npos) << msg;
   msg = load_error("scene: patient\nsimulation:\n  load_steps: many\n");
   EXPECT_NE(msg.find("expected an integer, got 'many'"), std::string::npos) << msg;
-  msg = load_error("scene: free-expansion\ninput:\n  phantom: {preset: case2-rca}\n");
+  msg = load_error("scene: generic-artery\ninput:\n  phantom: {preset: case2-rca}\n");
   EXPECT_NE(msg.find("has no artery input"), std::string::npos) << msg;
   msg = load_error("scene: patient\nscene: generic-artery\n");
   EXPECT_NE(msg.find("duplicate key 'scene'"), std::string::npos) << msg;

@@ -99,7 +99,7 @@ TEST_F(Cli, StenosisSectionReachesCenterlineAndPlacement) {
   stentsim::files::write_atomic(c, "scene: free-expansion\nstenosis: {threshold_percent: 30}\n");
   r = sh("run " + c.string());
   EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("stenosis: a free-expansion scene has no lumen"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("stenosis: a free-expansion scene without an input has no lumen"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, ForceUntilAndOnlyParseInEveryForm) {
