@@ -5,8 +5,9 @@
 // (zero twist, Bishop 1975; computed by the double reflection method of
 // Wang, Juettler, Zheng, Liu, ACM TOG 27(1), 2008).
 //
-// Built either straight (+z, centred at the origin: the free-expansion scene)
-// or along the balloon centerline spline of the placement. Where the device
+// Built either straight (+z, centred at the origin: the straight free expansion
+// and the generic artery) or along the balloon centerline spline of the
+// placement (a patient, a curved free expansion). Where the device
 // reaches beyond the spline's ends (smoothing may shorten the curve by a
 // few micrometres) the axis continues along the end tangent.
 #include <Eigen/Core>

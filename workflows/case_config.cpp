@@ -149,8 +149,10 @@ CaseConfig load_case(const std::filesystem::path& file) {
   c.output = parse_output(top.map("output"));
   c.placed = c.scene == Scene::patient || (c.scene == Scene::free_expansion && top.has("input"));
   if (top.has("stenosis") && !c.placed)
-    top.fail("stenosis", "a " + std::string(to_string(c.scene)) + " scene without an input has no lumen to find lesions in; "
-                         "remove this section");
+    top.fail("stenosis", c.scene == Scene::free_expansion
+                             ? "a free-expansion scene without an input has no lumen to find lesions in; remove this section, or "
+                               "add an input: to place the device along a vessel (the curved device)"
+                             : "a generic-artery scene has no lumen to find lesions in; remove this section");
   {
     auto st = top.map("stenosis");
     c.stenosis = parse_stenosis_rule(st);

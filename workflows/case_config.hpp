@@ -69,7 +69,7 @@ struct CaseConfig {
   FiberSettings fibers;
   SimulationSettings simulation;
   OutputSettings output;
-  /// The one stenosis rule (`stenosis:`; patient scenes): the segmentation's
+  /// The one stenosis rule (`stenosis:`; scenes with an input): the segmentation's
   /// region of interest and wall synthesis, the centerline stage's lesions
   /// and the placement's site.
   StenosisRule stenosis;

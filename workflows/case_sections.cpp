@@ -11,7 +11,10 @@ void validate_stage_sections(const CaseConfig& c, ConfigMap& top) {
     top.fail("input", "a generic-artery scene has no artery input (its artery is the paper's straight tube); remove this section");
   if (!c.placed) {
     if (top.has("centerline"))
-      top.fail("centerline", "a " + std::string(to_string(c.scene)) + " scene without an input has no lumen centerline; remove this section");
+      top.fail("centerline", c.scene == Scene::free_expansion
+                                 ? "a free-expansion scene without an input has no lumen centerline; remove this section, or add "
+                                   "an input: to place the device along a vessel (the curved device)"
+                                 : "a generic-artery scene has no lumen centerline; remove this section");
   } else {
     if (!top.has("input")) top.fail("input", "a patient scene needs an input section (e.g. input: {phantom: {preset: case2-rca}})");
     auto input = top.map("input");
@@ -28,8 +31,10 @@ void validate_stage_sections(const CaseConfig& c, ConfigMap& top) {
     auto placement = device.map("placement");
     device_gen::parse_placement_params(placement);
   } else if (device.has("placement")) {
-    device.fail("placement", "only a patient scene or a free expansion with an input places the device along a centerline; "
-                             "remove this section");
+    device.fail("placement", c.scene == Scene::free_expansion
+                                 ? "a free expansion without an input is straight; remove this section, or add an input: to "
+                                   "place the device along a vessel (the curved device)"
+                                 : "a generic-artery scene's device is straight; remove this section");
   }
   device.finish();
 }

@@ -191,7 +191,9 @@ Stage device_stage(const CaseConfig& c, const std::string& name) {
   const bool placed = c.placed;
   if (placed) s.inputs = {"placement/placement.yaml"};
   s.outputs = {name + "/" + name + ".vtu"};
-  s.config = slice(c, {name == "balloon" ? "device.balloon" : "device.stent"});
+  // Placed or straight is part of what the stage computes: a curved free
+  // expansion that loses its input must not keep its warped device.
+  s.config = slice(c, {name == "balloon" ? "device.balloon" : "device.stent"}) + (placed ? "placed;" : "straight;");
   s.version = "1";
   const auto d = device_design(c);
   s.run = [d, name, placed](StageContext& ctx) {

@@ -1,6 +1,8 @@
 #pragma once
 // Which stages a case needs (DESIGN.md §3): a free-expansion scene has no
-// artery, so no segmentation, centerline, wall mesh or fibers are made.
+// artery, so no wall mesh or fibers are made, and no segmentation or
+// centerline either unless it has an input to place its device along (the
+// curved device).
 #include <vector>
 
 #include "pipeline/stage.hpp"

@@ -1,5 +1,6 @@
 #include "solver/assembly/global_system.hpp"
 
+#include "common/log.hpp"
 #include "solver/assembly/parallel.hpp"
 
 #include <algorithm>
@@ -110,6 +111,7 @@ void GlobalSystem::finish() {
   for (GlobalDof d = 0; d < n; ++d)
     if (constraints_.fixed(d)) insert(d, d, 0.0);  // identity set below
   if (!pending_.empty()) {
+    const std::int64_t before = matrix_.nonzeros();
     // Rebuild the pattern as the union of the old one and the new entries.
     std::vector<std::vector<std::pair<std::int64_t, double>>> rows(static_cast<std::size_t>(n));
     for (GlobalDof i = 0; i < n; ++i)
@@ -134,6 +136,8 @@ void GlobalSystem::finish() {
       std::vector<std::pair<std::int64_t, double>>().swap(row);
     }
     ++matrix_.pattern_version;
+    log::debug("matrix pattern grew by {} entries to {} (the linear solver analyses it again)", matrix_.nonzeros() - before,
+               matrix_.nonzeros());
     pending_.clear();
   }
   for (GlobalDof d = 0; d < n; ++d)

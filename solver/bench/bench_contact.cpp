@@ -115,7 +115,9 @@ output: {{}}
       t->assemble(state, system);
       system.finish();
     };
+    const auto before = system.matrix().nonzeros();
     assemble(true);  // the first assembly reserves the pattern
+    const auto reserved = system.matrix().nonzeros() - before;
     const double with_tangent = time_median(5, [&] { assemble(true); });
     const double residual = time_median(5, [&] { assemble(false); });
     std::string active;
@@ -129,8 +131,8 @@ output: {{}}
       for (const auto& s : st.nodes) n += s.active;
       active = fmt::format("{} of {} slave nodes active, {} slave faces", n, st.nodes.size(), surface_pair->slave().faces().size());
     }
-    std::printf("%-14s search %7.1f ms, assembly with tangent %7.1f ms, residual only %7.1f ms (%s)\n", t->name().c_str(),
-                1e3 * search, 1e3 * with_tangent, 1e3 * residual, active.c_str());
+    std::printf("%-14s search %7.1f ms, assembly with tangent %7.1f ms, residual only %7.1f ms (%s; %lld matrix entries)\n",
+                t->name().c_str(), 1e3 * search, 1e3 * with_tangent, 1e3 * residual, active.c_str(), static_cast<long long>(reserved));
     contact_total += with_tangent + residual;
   }
   // One direct solve of the whole assembled system at u, for scale.

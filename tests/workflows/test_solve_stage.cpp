@@ -194,7 +194,8 @@ TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs
 // The curved free expansion (paper 3.2): a free expansion given a vessel is placed
 // along its centerline and warped onto it, and solved with no artery. Whether
 // inflation straightens the ring-centroid curve (the paper's finding) is printed
-// here, not judged: this small device bends further (README).
+// here, not judged: this small device bends further (0.092 -> 0.112 1/mm at
+// max), as the README's curved free expansion reports.
 TEST_F(SolveStage, CurvedFreeExpansionFollowsTheVesselWithNoArtery) {
   stentsim::files::write_atomic(dir / "fec.yaml",
                                 "name: fec-small\nscene: free-expansion\n"
@@ -221,18 +222,26 @@ TEST_F(SolveStage, CurvedFreeExpansionFollowsTheVesselWithNoArtery) {
   std::printf("ring-centroid curvature: %.4f 1/mm initial, %.4f at max, %.4f after; stent D %.3f mm at max\n", k0, k_max,
               k_after, qoi(sum, "stent_diameter_max"));
   EXPECT_GT(k0, 0.02);  // the phantom bends the device
-  EXPECT_GT(k_max, 0.0);
-  EXPECT_GT(k_after, 0.0);
   EXPECT_GT(qoi(sum, "stent_diameter_max"), 1.3);
   // The report judges it against the paper's curved device.
   const std::string report = stentsim::files::read_text(work / "report/report.md");
   EXPECT_NE(report.find("straightening"), std::string::npos) << report;
 
+  // Without its input the case is the straight device: the balloon and the stent are made again.
+  stentsim::files::write_atomic(dir / "fec.yaml",
+                                "name: fec-small\nscene: free-expansion\n"
+                                "device: {balloon: {length: 7 mm}, stent: {rings: 3}}\n"
+                                "simulation: {pressure_max: 0.6 MPa, load_steps: 10}\n");
+  r = run_stentsim("run " + (dir / "fec.yaml").string() + " --dry-run");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("run   balloon"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("run   stent"), std::string::npos) << r.out;
+
   // A generic artery takes no input; a free expansion without one takes no centerline section.
   stentsim::files::write_atomic(dir / "bad.yaml", "name: b\nscene: generic-artery\ninput: {phantom: {preset: tortuous}}\n");
   r = run_stentsim("run " + (dir / "bad.yaml").string() + " --dry-run");
   EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("input"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("has no artery input"), std::string::npos) << r.out;
   stentsim::files::write_atomic(dir / "bad2.yaml", "name: b\nscene: free-expansion\ncenterline: {spacing: 0.1 mm}\n");
   r = run_stentsim("run " + (dir / "bad2.yaml").string() + " --dry-run");
   EXPECT_EQ(r.code, 2) << r.out;
@@ -246,6 +255,7 @@ TEST_F(SolveStage, CurvedFreeExpansionFollowsTheVesselWithNoArtery) {
   EXPECT_NE(r.out.find("placement"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("fibers"), std::string::npos) << r.out;
   EXPECT_EQ(run_stentsim("init " + (dir / "init2").string() + " --curved --scene patient").code, 2);
+  EXPECT_EQ(run_stentsim("init " + (dir / "init3").string() + " --curved --cohort").code, 2);
 }
 
 // Rows of a CSV file after its header.

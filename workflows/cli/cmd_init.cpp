@@ -20,6 +20,10 @@ void register_init(CLI::App& app) {
                 "With --scene free-expansion: the paper's curved device (Section 3.2), placed along a phantom's centerline");
   sub->add_flag("--cohort", a->cohort, "Write an example cohort of six phantom patients (and its template case)");
   on(sub, [a, sub] {
+    if (a->cohort && a->curved) {
+      std::fprintf(stderr, "init: --curved and --cohort do not go together (the cohort's template is a patient case)\n");
+      return 2;
+    }
     if (a->cohort) {
       workflows::write_example_case(a->dir, "patient");
       const auto file = workflows::write_example_case(a->dir, "cohort");
