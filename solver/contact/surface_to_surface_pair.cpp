@@ -403,10 +403,10 @@ void SurfaceToSurfacePair::assemble(const SystemState& state, Assembler& out) {
       // Reserve node j's block over the master faces its Gauss points hit within the search
       // margin, active or not yet, so that contact usually starts inside the pattern the
       // linear solver has analysed. Only these: on the paper-scale benchmark (bench_contact)
-      // this pair's entries were 18.0 M over every candidate face of the search, 10.6 M with
-      // the hit faces' neighbours too and 4.1 M over the hit faces, and the first direct
-      // solve of the whole system took 37.5, 25.8 and 12.7 s. A point that slides onto a new
-      // face grows the pattern (the linear solver analyses it again; GlobalSystem logs it).
+      // this pair's entries would be 18.0 M over every candidate face of the search and
+      // 10.6 M with the hit faces' neighbours too, against 4.1 M over the hit faces, and a
+      // direct solver's fill grows with them. A point that slides onto a new face grows the
+      // pattern (the linear solver analyses it again; GlobalSystem logs it).
       // The global pattern only grows: a block is reserved again only when a hit face is
       // new, over the union with the faces reserved before.
       std::vector<int> hits;

@@ -23,21 +23,14 @@
 #include <string>
 
 #include "common/files.hpp"
-#include "common/summary.hpp"
 #include "tests/workflows/cli_runner.hpp"
+#include "tests/workflows/summary_qoi.hpp"
 
 namespace fs = std::filesystem;
-using stentsim::Summary;
 using stentsim::testing::run_stentsim;
+using stentsim::testing::summary_qoi;
 
 namespace {
-
-double qoi(const fs::path& summary, const std::string& name) {
-  const auto s = Summary::read(summary);
-  const auto it = s.qois().find(name);
-  if (it == s.qois().end()) throw std::runtime_error(summary.string() + ": no " + name);
-  return std::get<double>(it->second.value);
-}
 
 struct Expansion {
   double d_max, d_after, recoil, dogboning, dogboning_pressure;
@@ -54,8 +47,8 @@ Expansion run_example(const fs::path& dir, const std::string& pressure) {
   const auto r = run_stentsim("run " + (dir / "free-expansion.yaml").string());
   EXPECT_EQ(r.code, 0) << r.out;
   const fs::path sum = dir / "free-expansion.work/solve/summary.yaml";
-  Expansion e{qoi(sum, "stent_diameter_max"), qoi(sum, "stent_diameter_after"), qoi(sum, "recoil_percent"),
-              qoi(sum, "dogboning_percent"), qoi(sum, "dogboning_pressure")};
+  Expansion e{summary_qoi(sum, "stent_diameter_max"), summary_qoi(sum, "stent_diameter_after"), summary_qoi(sum, "recoil_percent"),
+              summary_qoi(sum, "dogboning_percent"), summary_qoi(sum, "dogboning_pressure")};
   std::printf("p_max %s: stent D %.4f mm at max (paper 2.59), %.4f mm after (paper 2.31), recoil %.2f %% (paper 10.8), "
               "dogboning %.1f %% at %.3f MPa (paper 20.4 %% at 10.4 atm = 1.054 MPa)\n",
               pressure.c_str(), e.d_max, e.d_after, e.recoil, e.dogboning, e.dogboning_pressure);

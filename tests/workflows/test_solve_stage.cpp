@@ -21,21 +21,16 @@
 #include "solver/io/scene.hpp"
 #include "solver/io/scene_kinds.hpp"
 #include "tests/workflows/cli_runner.hpp"
+#include "tests/workflows/summary_qoi.hpp"
 #include "workflows/case_config.hpp"
 #include "workflows/solve_stage.hpp"
 
 namespace fs = std::filesystem;
 using stentsim::Summary;
 using stentsim::testing::run_stentsim;
+using stentsim::testing::summary_qoi;
 
 namespace {
-
-double qoi(const fs::path& summary, const std::string& name) {
-  const auto s = Summary::read(summary);
-  const auto it = s.qois().find(name);
-  if (it == s.qois().end()) throw std::runtime_error(summary.string() + ": no " + name);
-  return std::get<double>(it->second.value);
-}
 
 class SolveStage : public ::testing::Test {
  protected:
@@ -63,14 +58,14 @@ TEST_F(SolveStage, FreeExpansionRunsThroughSolveWithOnlyTheDevice) {
 
   // The balloon pushes the crimped rings (1.15 mm) out; they spring back on deflation.
   const fs::path sum = work / "solve/summary.yaml";
-  EXPECT_NEAR(qoi(sum, "stent_diameter_initial"), 1.15, 0.02);  // the strut elements' end nodes, on the crimped cylinder
-  const double d_max = qoi(sum, "stent_diameter_max"), d_after = qoi(sum, "stent_diameter_after");
+  EXPECT_NEAR(summary_qoi(sum, "stent_diameter_initial"), 1.15, 0.02);  // the strut elements' end nodes, on the crimped cylinder
+  const double d_max = summary_qoi(sum, "stent_diameter_max"), d_after = summary_qoi(sum, "stent_diameter_after");
   EXPECT_GT(d_max, 1.3);
   EXPECT_LT(d_after, d_max);
   EXPECT_GT(d_after, 1.15);
-  EXPECT_NEAR(qoi(sum, "recoil_percent"), 100 * (d_max - d_after) / d_max, 1e-9);
-  EXPECT_EQ(qoi(sum, "stent_rings"), 1);
-  EXPECT_GT(qoi(sum, "contact_line_load_max_stent_balloon_max"), 0.0);
+  EXPECT_NEAR(summary_qoi(sum, "recoil_percent"), 100 * (d_max - d_after) / d_max, 1e-9);
+  EXPECT_EQ(summary_qoi(sum, "stent_rings"), 1);
+  EXPECT_GT(summary_qoi(sum, "contact_line_load_max_stent_balloon_max"), 0.0);
   EXPECT_EQ(Summary::read(sum).qois().count("balloon_profile_diameter_p0_6"), 1u);
   EXPECT_EQ(Summary::read(sum).qois().count("dogboning_percent"), 0u);  // one ring: no end and middle rings
 
@@ -96,7 +91,7 @@ TEST_F(SolveStage, FreeExpansionRunsThroughSolveWithOnlyTheDevice) {
   // The scene re-runs by hand to the same numbers.
   r = run_stentsim("solve " + (work / "solve/scene.yaml").string() + " --out " + (dir / "by-hand").string());
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NEAR(qoi(dir / "by-hand/summary.yaml", "stent_diameter_max"), d_max, 1e-9);
+  EXPECT_NEAR(summary_qoi(dir / "by-hand/summary.yaml", "stent_diameter_max"), d_max, 1e-9);
 
   // Up to date; a change of the simulation section re-runs the solve, not the device.
   r = run_stentsim("run " + (dir / "fe.yaml").string());
@@ -217,12 +212,12 @@ TEST_F(SolveStage, CurvedFreeExpansionFollowsTheVesselWithNoArtery) {
   EXPECT_EQ(scene.contacts.size(), 1u);
 
   const fs::path sum = work / "solve/summary.yaml";
-  const double k0 = qoi(sum, "stent_centroid_curvature_initial"), k_max = qoi(sum, "stent_centroid_curvature_max"),
-               k_after = qoi(sum, "stent_centroid_curvature_after");
+  const double k0 = summary_qoi(sum, "stent_centroid_curvature_initial"), k_max = summary_qoi(sum, "stent_centroid_curvature_max"),
+               k_after = summary_qoi(sum, "stent_centroid_curvature_after");
   std::printf("ring-centroid curvature: %.4f 1/mm initial, %.4f at max, %.4f after; stent D %.3f mm at max\n", k0, k_max,
-              k_after, qoi(sum, "stent_diameter_max"));
+              k_after, summary_qoi(sum, "stent_diameter_max"));
   EXPECT_GT(k0, 0.02);  // the phantom bends the device
-  EXPECT_GT(qoi(sum, "stent_diameter_max"), 1.3);
+  EXPECT_GT(summary_qoi(sum, "stent_diameter_max"), 1.3);
   // The report judges it against the paper's curved device.
   const std::string report = stentsim::files::read_text(work / "report/report.md");
   EXPECT_NE(report.find("straightening"), std::string::npos) << report;
@@ -305,8 +300,8 @@ TEST_F(SolveStage, AnInterruptedSolveContinuesFromItsLastCheckpoint) {
   EXPECT_NE(log.find("resuming the solve from the checkpoint of an earlier attempt"), std::string::npos) << log;
   EXPECT_NE(log.find("restart from"), std::string::npos) << log;
   for (const char* q : {"stent_diameter_max", "stent_diameter_after", "recoil_percent"})
-    EXPECT_NEAR(qoi(work / "solve/summary.yaml", q), qoi(ref / "summary.yaml", q), 1e-9) << q;
-  EXPECT_EQ(qoi(work / "solve/summary.yaml", "steps"), qoi(ref / "summary.yaml", "steps"));
+    EXPECT_NEAR(summary_qoi(work / "solve/summary.yaml", q), summary_qoi(ref / "summary.yaml", q), 1e-9) << q;
+  EXPECT_EQ(summary_qoi(work / "solve/summary.yaml", "steps"), summary_qoi(ref / "summary.yaml", "steps"));
   EXPECT_EQ(data_rows(work / "solve/history.csv"), data_rows(ref / "history.csv"));
   EXPECT_EQ(stentsim::files::read_text(work / "solve/results.pvd"), stentsim::files::read_text(ref / "results.pvd"));
   std::size_t frames = 0, ref_frames = 0;
@@ -324,7 +319,7 @@ TEST_F(SolveStage, AnInterruptedSolveContinuesFromItsLastCheckpoint) {
   const std::string log2 = stentsim::files::read_text(work / "logs/solve.log");
   EXPECT_NE(log2.find("not resuming from"), std::string::npos) << log2;
   EXPECT_NE(log2.find("written by another scene"), std::string::npos) << log2;
-  EXPECT_LT(qoi(work / "solve/summary.yaml", "stent_diameter_max"), qoi(ref / "summary.yaml", "stent_diameter_max"));
+  EXPECT_LT(summary_qoi(work / "solve/summary.yaml", "stent_diameter_max"), summary_qoi(ref / "summary.yaml", "stent_diameter_max"));
   EXPECT_EQ(log2.find("restart from", log2.find("not resuming from")), std::string::npos) << "it resumed: " << log2;
 }
 
