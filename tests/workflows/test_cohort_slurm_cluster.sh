@@ -86,7 +86,7 @@ for _ in $(seq 1 100); do [ -S "$B/munge/munge.socket.2" ] && break; sleep 0.05;
 # munged refuses a socket below a folder that others cannot enter (a build under mktemp -d's 0700 folder).
 [ -S "$B/munge/munge.socket.2" ] || {
   echo "munged did not start: $(tail -3 "$B/log/munged.out" "$B/log/munged.log" 2>/dev/null)"
-  echo "(munged needs every folder above $B to be searchable by all: chmod o+x on the one it names)"
+  echo "(munged needs execute permission for user, group and others on every folder above $B: chmod a+x on the one it names)"
   stop; exit 1; }
 setsid slurmctld -D -c -f "$SLURM_CONF" </dev/null >"$B/log/slurmctld.out" 2>&1 &
 echo $! >> "$B/pids"
