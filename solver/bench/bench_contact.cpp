@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "common/log.hpp"
 #include "solver/app/built_model.hpp"
@@ -48,8 +49,9 @@ double time_median(int repeats, F&& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: %s STENT.vtu BALLOON.vtu (see bench_contact.sh)\n", argv[0]);
+  const bool contact_only = argc == 4 && std::string(argv[3]) == "--contact-only";  // no direct solve (for profiling)
+  if (argc != 3 && !contact_only) {
+    std::fprintf(stderr, "usage: %s STENT.vtu BALLOON.vtu [--contact-only] (see bench_contact.sh)\n", argv[0]);
     return 2;
   }
   log::set_level(log::Level::warn);
@@ -134,6 +136,11 @@ output: {{}}
     std::printf("%-14s search %7.1f ms, assembly with tangent %7.1f ms, residual only %7.1f ms (%s; %lld matrix entries)\n",
                 t->name().c_str(), 1e3 * search, 1e3 * with_tangent, 1e3 * residual, active.c_str(), static_cast<long long>(reserved));
     contact_total += with_tangent + residual;
+  }
+  if (contact_only) {
+    std::printf("per Newton iteration: contact (tangent + one residual) %.1f ms\n", 1e3 * contact_total);
+    std::filesystem::remove_all(dir);
+    return 0;
   }
   // One direct solve of the whole assembled system at u, for scale.
   system.begin(zero, true);

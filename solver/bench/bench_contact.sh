@@ -19,4 +19,4 @@ balloon: {length: 18.0, elements_around: 35, elements_along: 79}
 YAML
 "$build/workflows/stentsim" stent --device "$work/device.yaml" --out "$work/stent.vtu" > /dev/null
 "$build/workflows/stentsim" balloon --device "$work/device.yaml" --out "$work/balloon.vtu" > /dev/null
-"$build/solver/bench_contact" "$work/stent.vtu" "$work/balloon.vtu"
+"$build/solver/bench_contact" "$work/stent.vtu" "$work/balloon.vtu" "${@:2}"
