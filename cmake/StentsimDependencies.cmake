@@ -53,6 +53,10 @@ stentsim_require(VTK_FOUND libvtk9-dev "VTK 9.1 (${VTK_NOT_FOUND_MESSAGE})")
 find_package(pugixml QUIET)
 stentsim_require(pugixml_FOUND libpugixml-dev "pugixml")
 
+# zlib: NIfTI .nii.gz headers and sizes are checked before VTK reads them.
+find_package(ZLIB QUIET)
+stentsim_require(ZLIB_FOUND zlib1g-dev "zlib")
+
 find_package(CGAL QUIET)
 stentsim_require(CGAL_FOUND libcgal-dev "CGAL")
 

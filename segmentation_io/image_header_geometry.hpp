@@ -32,14 +32,4 @@ struct IndexToWorld {
 std::optional<IndexToWorld> nrrd_index_to_world(const std::filesystem::path& header);
 std::optional<IndexToWorld> metaimage_index_to_world(const std::filesystem::path& header);
 
-/// A MetaImage's uncompressed voxel data (in the .mha after its header, or the
-/// .mhd's ElementDataFile) against what DimSize, ElementType and
-/// ElementNumberOfChannels need: InputError naming the file when it is shorter
-/// (cut short) or the data file is not a regular file (a device, a pipe).
-/// Compressed data and element types it does not know are left to the reader.
-void check_metaimage_data_size(const std::filesystem::path& header);
-/// The same for a raw-encoded NRRD (attached after the header's blank line, or its
-/// `data file`); gzip, bzip2 and text encodings are left to the reader.
-void check_nrrd_data_size(const std::filesystem::path& header);
-
 }  // namespace stentsim::segmentation

@@ -27,6 +27,7 @@
 
 #include "common/error.hpp"
 #include "segmentation_io/branch_extraction.hpp"
+#include "segmentation_io/image_header_checks.hpp"
 #include "segmentation_io/image_header_geometry.hpp"
 #include "segmentation_io/label_image.hpp"
 #include "segmentation_io/vtk_read_errors.hpp"
@@ -69,19 +70,20 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
   if (ends_with(lower, ".nii") || ends_with(lower, ".nii.gz")) {
     auto r = vtkSmartPointer<vtkNIFTIImageReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable NIfTI file", name));
+    check_nifti_header(file);  // VTK's reader trusts the header and crashes on a damaged one
     image = read_voxels(r.Get(), name, "NIfTI");
     if (r->GetSFormMatrix()) to_world = r->GetSFormMatrix();
     else if (r->GetQFormMatrix()) to_world = r->GetQFormMatrix();
   } else if (ends_with(lower, ".nrrd") || ends_with(lower, ".nhdr")) {
     auto r = vtkSmartPointer<vtkNrrdReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable NRRD file", name));
-    check_nrrd_data_size(file);  // vtkImageReader reports a short read as a generic warning only
+    check_nrrd_header(file);  // VTK's reader trusts the header (field order, sizes, data file patterns)
     image = read_voxels(r.Get(), name, "NRRD");
     header_geometry = nrrd_index_to_world(file);
   } else if (ends_with(lower, ".mha") || ends_with(lower, ".mhd")) {
     auto r = vtkSmartPointer<vtkMetaImageReader>::New();
     if (!r->CanReadFile(name.c_str())) throw InputError(fmt::format("{}: not a readable MetaImage file", name));
-    check_metaimage_data_size(file);  // MetaIO reports a short read on stderr only
+    check_metaimage_header(file);  // MetaIO reports a short read on stderr only
     image = read_voxels(r.Get(), name, "MetaImage");
     header_geometry = metaimage_index_to_world(file);
   } else {
@@ -229,6 +231,9 @@ TriSurface label_image_surface(const std::filesystem::path& file, const LabelSur
     s = clip_by_plane(s, plane_point, -inward);
   }
   auto pieces = connected_pieces(s);
+  if (pieces.empty())
+    throw InputError(fmt::format("{}: nothing of the labelled region is left between the two end cuts ({:.3g} mm in from each "
+                                 "end); is the voxel spacing right?", name, trim));
   return pieces.front();
 }
 
@@ -238,6 +243,7 @@ std::optional<std::string> nifti_spatial_units(const std::filesystem::path& file
   if (!(ends_with(lower, ".nii") || ends_with(lower, ".nii.gz")) || !std::filesystem::exists(file)) return std::nullopt;
   auto r = vtkSmartPointer<vtkNIFTIImageReader>::New();
   if (!r->CanReadFile(file.string().c_str())) return std::nullopt;
+  check_nifti_header(file);
   r->SetFileName(file.string().c_str());
   r->UpdateInformation();
   switch (r->GetNIFTIHeader()->GetXYZTUnits() & 0x07) {

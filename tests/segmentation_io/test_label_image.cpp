@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -395,5 +396,70 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
   }
   e = error_of(dir / "flat.nrrd");
   EXPECT_NE(e.find("axis 2 has zero spacing"), std::string::npos) << e;
+  fs::remove_all(dir);
+}
+
+// Damaged headers that crashed or hung VTK 9.1's readers, or stentsim behind them
+// (found by test_fuzz_label_images), are input errors naming the file and field.
+TEST(LabelImage, DamagedHeadersAreInputErrorsNotCrashes) {
+  const fs::path dir = fs::temp_directory_path() / "stentsim_label_damaged";
+  fs::create_directories(dir);
+  const double zero[3] = {0, 0, 0};
+  auto im = cylinder(zero);
+  const std::string voxels(static_cast<const char*>(im->GetScalarPointer()), std::size_t(kDim[0]) * kDim[1] * kDim[2]);
+  auto error_of = [](const fs::path& f) -> std::string {
+    LabelSurfaceOptions o;
+    o.labels = {1};
+    try {
+      label_image_surface(f, o);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  auto write = [](const fs::path& f, const std::string& bytes) { std::ofstream(f, std::ios::binary) << bytes; };
+  auto slurp = [](const fs::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  // NIfTI: 11 bytes inserted inside the header shift datatype, bitpix, pixdim and
+  // vox_offset (segfault in vtkNIFTIImageReader::RequestInformation).
+  {
+    auto w = vtkSmartPointer<vtkNIFTIImageWriter>::New();
+    w->SetInputData(im);
+    w->SetFileName((dir / "good.nii").c_str());
+    w->Write();
+    std::string nii = slurp(dir / "good.nii");
+    write(dir / "shifted.nii", nii.insert(71, std::string(11, '\xfc')));
+  }
+  std::string e = error_of(dir / "shifted.nii");
+  EXPECT_NE(e.find("shifted.nii: NIfTI magic is not 'n+1'"), std::string::npos) << e;
+  // NRRD without a dimension (segfault reading the voxels) and with a NUL in its header
+  // (VTK loses the data offset: the read never ended).
+  const std::string nrrd_tail = "sizes: " + std::to_string(kDim[0]) + " " + std::to_string(kDim[1]) + " " +
+                                std::to_string(kDim[2]) + "\nspacings: 0.1 0.1 0.1\nencoding: raw\n";
+  write(dir / "nodim.nrrd", "NRRD0004\ntype: uint8\n" + nrrd_tail + "\n" + voxels);
+  e = error_of(dir / "nodim.nrrd");
+  EXPECT_NE(e.find("nodim.nrrd: NRRD field 'sizes' comes before 'dimension: 3'"), std::string::npos) << e;
+  write(dir / "nul.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nkind: domain" + std::string(1, '\0') + "domain\n" + nrrd_tail +
+                              "\n" + voxels);
+  e = error_of(dir / "nul.nrrd");
+  EXPECT_NE(e.find("nul.nrrd: the NRRD header holds a NUL byte"), std::string::npos) << e;
+  // MetaImage with NDims = 2^32 - 1 (MetaIO never returned).
+  const std::string mha_tail = "\nDimSize = " + std::to_string(kDim[0]) + " " + std::to_string(kDim[1]) + " " +
+                               std::to_string(kDim[2]) + "\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n" + voxels;
+  write(dir / "ndims.mha", "ObjectType = Image\nNDims = 4294967295\nElementSpacing = 0.1 0.1 0.1" + mha_tail);
+  e = error_of(dir / "ndims.mha");
+  EXPECT_NE(e.find("ndims.mha: MetaImage NDims = '4294967295' -- expected 3"), std::string::npos) << e;
+  // A spacing so large along one axis that the end cuts leave nothing (segfault on the
+  // empty piece list); the header itself is valid. A 14 x 14 x 30 cylinder, as the fuzz seed.
+  std::string small(14 * 14 * 30, '\0');
+  for (int k = 3; k <= 26; ++k)
+    for (int j = 0; j < 14; ++j)
+      for (int i = 0; i < 14; ++i) small[std::size_t(i + 14 * (j + 14 * k))] = std::hypot(i - 6.5, j - 6.5) < 3.5 ? 1 : 0;
+  write(dir / "wide.mha", "ObjectType = Image\nNDims = 3\nElementSpacing = 4294967295.5 0.5 0.5\nDimSize = 14 14 30\n"
+                          "ElementType = MET_UCHAR\nElementDataFile = LOCAL\n" + small);
+  e = error_of(dir / "wide.mha");
+  EXPECT_NE(e.find("wide.mha: nothing of the labelled region is left between the two end cuts"), std::string::npos) << e;
   fs::remove_all(dir);
 }

@@ -24,6 +24,7 @@
 #include "common/mesh_data.hpp"
 #include "segmentation_io/phantom.hpp"
 #include "segmentation_io/surface_input.hpp"
+#include "tests/fuzz/mutation.hpp"
 #include "tests/segmentation_io/polydata_fixture.hpp"
 
 using namespace stentsim;
@@ -31,11 +32,6 @@ using namespace stentsim::segmentation;
 namespace fs = std::filesystem;
 
 namespace {
-
-int iterations() {
-  const char* n = std::getenv("STENTSIM_FUZZ_ITERATIONS");
-  return n ? std::max(1, std::atoi(n)) : 300;
-}
 
 TriSurface small_tube() {
   PhantomSpec s = phantom_preset("straight-healthy", 1);
@@ -101,42 +97,6 @@ std::string vtp_text(const fs::path& dir, const TriSurface& s) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// One mutation of `seed`: a few bit flips, a byte run inserted or deleted, a cut,
-// a number replaced by a huge one, "nan" or an index past the points.
-std::string mutate(const std::string& seed, std::mt19937& gen) {
-  std::string s = seed;
-  std::uniform_int_distribution<int> kind(0, 6);
-  auto at = [&](std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n ? n - 1 : 0)(gen); };
-  switch (kind(gen)) {
-    case 0:
-      for (int k = 0; k < 1 + static_cast<int>(at(8)); ++k) s[at(s.size())] ^= static_cast<char>(1 << at(8));
-      break;
-    case 1: s.insert(at(s.size()), std::string(1 + at(16), static_cast<char>(at(256)))); break;
-    case 2: {
-      const std::size_t p = at(s.size());
-      s.erase(p, 1 + at(64));
-      break;
-    }
-    case 3: s.resize(at(s.size())); break;
-    case 4: {  // a digit run replaced by a huge count
-      const std::size_t p = s.find_first_of("0123456789", at(s.size()));
-      if (p != std::string::npos) s.replace(p, s.find_first_not_of("0123456789", p) - p, "4294967295");
-      break;
-    }
-    case 5: {
-      const std::size_t p = s.find_first_of("0123456789", at(s.size()));
-      if (p != std::string::npos) s.replace(p, 1, "nan");
-      break;
-    }
-    default: {  // four raw bytes (a binary count or coordinate) overwritten
-      const std::uint32_t v = std::uniform_int_distribution<std::uint32_t>()(gen);
-      if (s.size() > 4) std::memcpy(s.data() + at(s.size() - 4), &v, 4);
-      break;
-    }
-  }
-  return s;
-}
-
 }  // namespace
 
 TEST(ReaderFuzz, MutatedSurfacesReadOrFailWithAnInputError) {
@@ -151,11 +111,11 @@ TEST(ReaderFuzz, MutatedSurfacesReadOrFailWithAnInputError) {
                                               {"t51.vtk", vtk51_text(dir, tube)}};
   if (std::getenv("STENTSIM_FUZZ_VTP")) seeds["t.vtp"] = vtp_text(dir, tube);
   std::mt19937 gen(20261202);
-  const int n = iterations();
+  const int n = fuzz::iterations();
   for (const auto& [name, seed] : seeds) {
     int read = 0, refused = 0;
     for (int i = 0; i < n; ++i) {
-      const std::string input = mutate(seed, gen);
+      const std::string input = fuzz::mutate(seed, gen);
       const fs::path f = dir / name;
       {
         std::ofstream out(f, std::ios::binary | std::ios::trunc);

@@ -1,0 +1,101 @@
+#pragma once
+// The mutations every reader fuzz test applies to copies of valid files, and
+// the loop that judges each mutant: it must either read (a valid input) or
+// fail with an InputError naming the file; a crash, a hang, std::bad_alloc or
+// any other exception fails the test. A fixed seed; 300 mutants per format in
+// the quick set, STENTSIM_FUZZ_ITERATIONS more (the validation variants).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+
+#include "common/error.hpp"
+
+namespace stentsim::fuzz {
+
+inline int iterations() {
+  const char* n = std::getenv("STENTSIM_FUZZ_ITERATIONS");
+  return n ? std::max(1, std::atoi(n)) : 300;
+}
+
+/// One mutation of `seed`: a few bit flips, a byte run inserted or deleted, a cut,
+/// a number replaced by a huge one, "nan" or four raw bytes (a binary count,
+/// offset or coordinate) overwritten.
+inline std::string mutate(const std::string& seed, std::mt19937& gen) {
+  std::string s = seed;
+  std::uniform_int_distribution<int> kind(0, 6);
+  auto at = [&](std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n ? n - 1 : 0)(gen); };
+  if (s.empty()) return s;
+  switch (kind(gen)) {
+    case 0:
+      for (int k = 0; k < 1 + static_cast<int>(at(8)); ++k) s[at(s.size())] ^= static_cast<char>(1 << at(8));
+      break;
+    case 1: s.insert(at(s.size()), std::string(1 + at(16), static_cast<char>(at(256)))); break;
+    case 2: {
+      const std::size_t p = at(s.size());
+      s.erase(p, 1 + at(64));
+      break;
+    }
+    case 3: s.resize(at(s.size())); break;
+    case 4: {  // a digit run replaced by a huge count
+      const std::size_t p = s.find_first_of("0123456789", at(s.size()));
+      if (p != std::string::npos) s.replace(p, s.find_first_not_of("0123456789", p) - p, "4294967295");
+      break;
+    }
+    case 5: {
+      const std::size_t p = s.find_first_of("0123456789", at(s.size()));
+      if (p != std::string::npos) s.replace(p, 1, "nan");
+      break;
+    }
+    default: {
+      const std::uint32_t v = std::uniform_int_distribution<std::uint32_t>()(gen);
+      if (s.size() > 4) std::memcpy(s.data() + at(s.size() - 4), &v, 4);
+      break;
+    }
+  }
+  return s;
+}
+
+inline void write_file(const std::filesystem::path& f, const std::string& bytes) {
+  std::ofstream out(f, std::ios::binary | std::ios::trunc);
+  out << bytes;
+}
+
+struct Tally {
+  int read = 0, refused = 0;
+};
+
+/// Runs `read` on n mutants that `make(i)` writes (returning the file the error
+/// must name); counts valid reads and input errors, fails on anything else.
+inline Tally judge(const std::string& format, int n, const std::function<std::filesystem::path(int)>& make,
+                   const std::function<void(const std::filesystem::path&)>& read) {
+  Tally t;
+  for (int i = 0; i < n; ++i) {
+    const std::filesystem::path named = make(i);
+    try {
+      read(named);
+      ++t.read;
+    } catch (const InputError& e) {
+      ++t.refused;
+      EXPECT_NE(std::string(e.what()).find(named.string()), std::string::npos) << format << " mutant " << i << ": " << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << format << " mutant " << i << ": not an InputError: " << e.what();
+      return t;
+    }
+    if (::testing::Test::HasFatalFailure()) return t;
+  }
+  std::printf("%-16s %d mutants: %d read, %d refused with an input error\n", format.c_str(), n, t.read, t.refused);
+  std::fflush(stdout);
+  return t;
+}
+
+}  // namespace stentsim::fuzz
