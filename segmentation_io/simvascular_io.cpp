@@ -226,6 +226,16 @@ TriSurface loft_contours(const SvPath& path, std::vector<SvContour> contours, co
   auto P = [&](long r, int j) -> const Vector3d& {
     return rings[std::size_t(std::clamp<long>(r, 0, long(m) - 1))].pts[std::size_t(j)];
   };
+  // The ring count is bounded before anything is allocated: one contour point far off
+  // (a damaged coordinate) would otherwise ask for billions of rings.
+  constexpr double kMaxRings = 100000;
+  double rings_needed = 0;
+  for (std::size_t r = 0; r + 1 < m; ++r)
+    rings_needed += std::max(1.0, std::ceil((centroid(rings[r + 1].pts) - centroid(rings[r].pts)).norm() / h));
+  if (!(rings_needed <= kMaxRings))
+    throw InputError(fmt::format("{}: lofting the contours at {:.3g} mm between rings needs {:.3g} rings (at most {:.0f}): the "
+                                 "contours span {:.3g} mm; is a coordinate far off or a contour degenerate?",
+                                 what, h, rings_needed, kMaxRings, (centroid(rings.back().pts) - centroid(rings.front().pts)).norm()));
   std::vector<std::vector<Vector3d>> all;
   for (std::size_t r = 0; r + 1 < m; ++r) {
     double gap = (centroid(rings[r + 1].pts) - centroid(rings[r].pts)).norm();

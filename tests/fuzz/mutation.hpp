@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -70,17 +71,27 @@ inline void write_file(const std::filesystem::path& f, const std::string& bytes)
   out << bytes;
 }
 
+/// A failing mutant copied where the next run does not overwrite it, to reproduce the failure.
+inline std::string keep(const std::filesystem::path& f) {
+  std::error_code ec;
+  const auto copy = std::filesystem::temp_directory_path() / ("stentsim_fuzz_failing_" + f.filename().string());
+  std::filesystem::copy_file(f, copy, std::filesystem::copy_options::overwrite_existing, ec);
+  return ec ? std::string() : " (kept as " + copy.string() + ")";
+}
+
 struct Tally {
   int read = 0, refused = 0;
 };
 
 /// Runs `read` on n mutants that `make(i)` writes (returning the file the error
-/// must name); counts valid reads and input errors, fails on anything else.
+/// must name); counts valid reads and input errors, fails on anything else and on
+/// a mutant that takes longer than 30 s (a clear error must come within that).
 inline Tally judge(const std::string& format, int n, const std::function<std::filesystem::path(int)>& make,
                    const std::function<void(const std::filesystem::path&)>& read) {
   Tally t;
   for (int i = 0; i < n; ++i) {
     const std::filesystem::path named = make(i);
+    const auto start = std::chrono::steady_clock::now();
     try {
       read(named);
       ++t.read;
@@ -88,9 +99,11 @@ inline Tally judge(const std::string& format, int n, const std::function<std::fi
       ++t.refused;
       EXPECT_NE(std::string(e.what()).find(named.string()), std::string::npos) << format << " mutant " << i << ": " << e.what();
     } catch (const std::exception& e) {
-      ADD_FAILURE() << format << " mutant " << i << ": not an InputError: " << e.what();
+      ADD_FAILURE() << format << " mutant " << i << ": not an InputError: " << e.what() << keep(named);
       return t;
     }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_LT(seconds, 30.0) << format << " mutant " << i << " took " << seconds << " s";
     if (::testing::Test::HasFatalFailure()) return t;
   }
   std::printf("%-16s %d mutants: %d read, %d refused with an input error\n", format.c_str(), n, t.read, t.refused);

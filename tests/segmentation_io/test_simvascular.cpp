@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <string>
 
 #include <unistd.h>
@@ -252,5 +253,28 @@ TEST(SimVascular, LoftAlongACurvedPathFollowsTheArc) {
   const double e_fine = std::max(fine.dmax - kTube, kTube - sag - fine.dmin);
   EXPECT_LT(e_fine, 0.5 * e_coarse);
   EXPECT_LT(std::abs(fine.volume / exact - 1), std::abs(coarse.volume / exact - 1));
+  fs::remove_all(dir);
+}
+
+// One contour point far off (a damaged coordinate, z = 6293502 mm instead of 6) asked
+// the loft for billions of rings: std::bad_alloc. It is an input error naming the file.
+TEST(SimVascular, AContourPointFarOffIsAnInputError) {
+  const fs::path dir = fs::temp_directory_path() / ("stentsim_sv_far_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string text;
+  {
+    std::ifstream in(kData / "straight_lad_lumen.ctgr", std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::string point = "<point id=\"3\" x=\"-0.330129181\" y=\"1.463220668\" z=\"6.000000\" />";
+  const auto at = text.find(point);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, point.size(), "<point id=\"3\" x=\"-0.330129181\" y=\"1.463220668\" z=\"6293502\" />");
+  std::ofstream(dir / "far.ctgr", std::ios::binary) << text;
+  const std::string e = error_of([&] {
+    loft_contours(read_simvascular_path(kData / "straight_lad.pth"), read_simvascular_contours(dir / "far.ctgr"), LoftOptions{},
+                  (dir / "far.ctgr").string());
+  });
+  EXPECT_NE(e.find("far.ctgr: lofting the contours"), std::string::npos) << e;
   fs::remove_all(dir);
 }
