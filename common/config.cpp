@@ -14,9 +14,25 @@ namespace {
 
 std::string fmt_number(double v) { return fmt::format("{:g}", v); }
 
+/// The most values a YAML file may hold with its aliases expanded. Aliases share
+/// nodes, so ten of an anchor per level over nine levels load as a few dozen
+/// nodes but are a billion values to every walk over them (this check, hashes,
+/// emitters): such a file is refused rather than walked.
+constexpr long kMaxYamlValues = 1000000;
+/// yaml-cpp's parser stops at 2000 levels of nesting, but an alias inside its own
+/// anchor (`x: &x [*x]`) loads as a cycle, endlessly deep to a walk.
+constexpr int kMaxYamlDepth = 2000;
+
 /// yaml-cpp keeps the first of two equal map keys and drops the second
 /// silently; a case file must not mean something other than it says.
-void reject_duplicate_keys(const YAML::Node& n, const std::filesystem::path& file, const std::string& path) {
+void reject_duplicate_keys(const YAML::Node& n, const std::filesystem::path& file, const std::string& path, long& values,
+                           int depth = 0) {
+  if (++values > kMaxYamlValues)
+    throw InputError(fmt::format("{}: the YAML holds more than {} values once its aliases (*name) are expanded; write the "
+                                 "values out instead of repeating anchors", file.string(), kMaxYamlValues));
+  if (depth > kMaxYamlDepth)
+    throw InputError(fmt::format("{}: the YAML nests deeper than {} levels (an alias inside its own anchor?)", file.string(),
+                                 kMaxYamlDepth));
   if (n.IsMap()) {
     std::set<std::string> seen;
     for (const auto& kv : n) {
@@ -26,10 +42,10 @@ void reject_duplicate_keys(const YAML::Node& n, const std::filesystem::path& fil
         const auto m = kv.first.Mark();
         throw InputError(fmt::format("{}:{}:{}: {}: duplicate key '{}'", file.string(), m.line + 1, m.column + 1, kp, k));
       }
-      reject_duplicate_keys(kv.second, file, kp);
+      reject_duplicate_keys(kv.second, file, kp, values, depth + 1);
     }
   } else if (n.IsSequence()) {
-    for (std::size_t i = 0; i < n.size(); ++i) reject_duplicate_keys(n[i], file, fmt::format("{}[{}]", path, i));
+    for (std::size_t i = 0; i < n.size(); ++i) reject_duplicate_keys(n[i], file, fmt::format("{}[{}]", path, i), values, depth + 1);
   }
 }
 
@@ -76,7 +92,8 @@ ConfigMap ConfigMap::load(const std::filesystem::path& file) {
                                  printable(e.msg)));
   }
   if (!root.IsMap()) throw InputError(fmt::format("{}: expected a YAML map at the top level", file.string()));
-  reject_duplicate_keys(root, file, "");
+  long values = 0;
+  reject_duplicate_keys(root, file, "", values);
   return ConfigMap(root, std::make_shared<const std::filesystem::path>(file), "");
 }
 
@@ -89,7 +106,8 @@ ConfigMap ConfigMap::from_string(const std::string& text, const std::filesystem:
                                  printable(e.msg)));
   }
   if (!root.IsMap()) throw InputError(fmt::format("{}: expected a YAML map at the top level", file.string()));
-  reject_duplicate_keys(root, file, "");
+  long values = 0;
+  reject_duplicate_keys(root, file, "", values);
   return ConfigMap(root, std::make_shared<const std::filesystem::path>(file), "");
 }
 

@@ -127,6 +127,7 @@ BeamBodyDesc read_beam_body(ConfigMap& beam) {
   if (has_file) {
     const auto path = beam.path("file");
     if (path.extension() != ".vtu") beam.fail("file", "expected a .vtu file (the stent stage's stent.vtu)");
+    if (!std::filesystem::is_regular_file(path)) beam.fail("file", fmt::format("no such file: {}", path.string()));
     if (beam.has("section")) beam.fail("section", "a stent file carries its section (SectionRadius); remove 'section'");
     if (beam.has("interpolation") && beam.string("interpolation") != "hermite3")
       beam.fail("interpolation", "stent files hold Hermite elements (end, end, middle node): use hermite3");

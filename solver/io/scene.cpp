@@ -31,6 +31,7 @@ MeshData read_mesh(ConfigMap& m, std::string& source) {
     const auto path = m.path("file");
     source = path.string();
     if (path.extension() != ".vtu") m.fail("file", "expected a .vtu file");
+    if (!std::filesystem::is_regular_file(path)) m.fail("file", fmt::format("no such file: {}", path.string()));
     return read_vtu(path.string());
   }
   ConfigMap g = m.map("generate");
@@ -251,6 +252,8 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
       } else if (f->has("file")) {
         body.frames.kind = FrameSource::Kind::file;
         body.frames.file = f->path("file");
+        if (!std::filesystem::is_regular_file(body.frames.file))
+          f->fail("file", fmt::format("no such file: {}", body.frames.file.string()));
         body.frames.radial = f->string("radial", body.frames.radial);
         body.frames.circumferential = f->string("circumferential", body.frames.circumferential);
         body.frames.longitudinal = f->string("longitudinal", body.frames.longitudinal);

@@ -86,6 +86,24 @@ TEST(Config, DuplicateKeysAreErrors) {
   EXPECT_NE(msg.find("cases[0].x: duplicate key 'x'"), std::string::npos) << msg;
 }
 
+// Aliases share nodes: nine levels of ten aliases load at once but are a billion values
+// to every walk (the duplicate-key check never returned), and an alias inside its own
+// anchor is a cycle (a walk recursed until the stack overflowed). Both are refused.
+TEST(Config, AliasBombsAndCyclesAreErrors) {
+  std::string bomb = "l0: &l0 [a, a, a, a, a, a, a, a, a, a]\n";
+  for (int level = 1; level <= 9; ++level) {
+    bomb += "l" + std::to_string(level) + ": &l" + std::to_string(level) + " [";
+    for (int k = 0; k < 10; ++k) bomb += (k ? ", *l" : "*l") + std::to_string(level - 1);
+    bomb += "]\n";
+  }
+  auto msg = error_of([&] { ConfigMap::from_string(bomb, "bomb.yaml"); });
+  EXPECT_NE(msg.find("bomb.yaml: the YAML holds more than 1000000 values once its aliases"), std::string::npos) << msg;
+  msg = error_of([] { ConfigMap::from_string("x: &x [*x]\n", "cycle.yaml"); });
+  EXPECT_NE(msg.find("cycle.yaml: the YAML nests deeper than 2000 levels"), std::string::npos) << msg;
+  // A few aliases are fine.
+  EXPECT_NO_THROW(ConfigMap::from_string("a: &a {x: 1}\nb: *a\n", "ok.yaml"));
+}
+
 TEST(Config, PathsAreAbsoluteAndRelativeToTheFile) {
   auto top = ConfigMap::from_string("lumen: lumen.stl\n", "cases/p.yaml");
   const auto p = top.path("lumen");
