@@ -98,6 +98,22 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
       else pending_.emplace_back(gi, gj, kv(i, j));
     }
   }
+  if (pending_.size() > compact_at_) compact_pending();
+}
+
+void GlobalSystem::compact_pending() {
+  std::sort(pending_.begin(), pending_.end(), [](const auto& a, const auto& b) {
+    return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) < std::get<0>(b) : std::get<1>(a) < std::get<1>(b);
+  });
+  std::size_t out = 0;
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
+    if (out > 0 && std::get<0>(pending_[out - 1]) == std::get<0>(pending_[k]) && std::get<1>(pending_[out - 1]) == std::get<1>(pending_[k]))
+      std::get<2>(pending_[out - 1]) += std::get<2>(pending_[k]);
+    else
+      pending_[out++] = pending_[k];
+  }
+  pending_.resize(out);
+  compact_at_ = std::max(compact_at_, 2 * out);
 }
 
 void GlobalSystem::finish() {

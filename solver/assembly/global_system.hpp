@@ -57,6 +57,11 @@ class GlobalSystem : public Assembler {
   Eigen::VectorXd residual_, correction_, prescribed_, magnitude_;
   CsrMatrix matrix_;
   std::vector<std::tuple<GlobalDof, GlobalDof, double>> pending_;  // entries outside the pattern
+  /// Merges pending_'s repeated (row, column) entries once it holds more than
+  /// `compact_at_`: overlapping element blocks that grow the pattern together (contact
+  /// node blocks: ~6 adds per new entry) would otherwise hold every add until finish().
+  void compact_pending();
+  std::size_t compact_at_ = std::size_t{1} << 22;
   bool with_tangent_ = true;
   int rank_ = 0, ranks_ = 1;
   // scratch for frame rotations (grows, never shrinks: no per-element allocation)

@@ -48,9 +48,13 @@ DirectionProjection project_along_direction(const ContactSurface& s, int face, c
   for (int it = 0; it < 30; ++it) {
     fp = face_point(s, f, face_shape(f.kind, xi[0], xi[1]));
     const Vec3 F = fp.x - p - alpha * d;
-    Eigen::FullPivLU<Mat3> lu(jacobian(fp, d));
-    if (!lu.isInvertible()) return r;  // the ray is parallel to the face
-    const Vec3 dy = -lu.solve(F);
+    // J⁻¹ by cofactors: J's columns a = x,1, b = x,2, c = −d; rows of J⁻¹ are (b×c, c×a, a×b)/det.
+    const Vec3 &a = fp.dx[0], &b = fp.dx[1];
+    const Vec3 c = -d;
+    const Vec3 bc = b.cross(c), ca = c.cross(a), ab = a.cross(b);
+    const double det = a.dot(bc);
+    if (!(std::abs(det) > 1e-12 * a.norm() * b.norm() * c.norm())) return r;  // the ray is parallel to the face
+    const Vec3 dy = -Vec3(bc.dot(F), ca.dot(F), ab.dot(F)) / det;
     xi[0] += dy[0], xi[1] += dy[1], alpha += dy[2];
     if (!std::isfinite(alpha) || std::abs(xi[0]) > 1e3 || std::abs(xi[1]) > 1e3) return r;
     if (F.norm() <= tol && dy.head<2>().norm() <= 1e-12) {

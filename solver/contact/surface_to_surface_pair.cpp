@@ -11,6 +11,7 @@
 #include "common/log.hpp"
 #include "solver/contact/owned_flags.hpp"
 #include "solver/beams/element_reference.hpp"
+#include "solver/contact/face_bounds.hpp"
 #include "solver/contact/face_search.hpp"
 #include "solver/terms/element_failure.hpp"
 
@@ -123,8 +124,8 @@ void SurfaceToSurfacePair::begin_step(const SystemState& state) {
   active_.begin_step();
 }
 
-void SurfaceToSurfacePair::point_gaps(const ContactSurface& slave, const ContactSurface& master, const Candidates& cand, int face,
-                                      std::vector<PointGap>& out) const {
+void SurfaceToSurfacePair::point_gaps(const ContactSurface& slave, const ContactSurface& master, const Candidates& cand,
+                                      const std::vector<Eigen::AlignedBox3d>& master_boxes, int face, std::vector<PointGap>& out) const {
   const SurfaceFace& f = slave.faces()[static_cast<std::size_t>(face)];
   const int nk = f.count;
   const auto& rule = gauss_[static_cast<std::size_t>(face)];
@@ -135,7 +136,9 @@ void SurfaceToSurfacePair::point_gaps(const ContactSurface& slave, const Contact
     for (int k = 0; k < nk; ++k) p += sh.n[k] * slave.x(f.node[k]), m += sh.n[k] * slave.normal(f.node[k]);
     const Vec3 d = m.normalized();
     PointGap& pg = out[q];
+    const double reach = settings_.search_margin;
     for (int mf : cand[static_cast<std::size_t>(face)]) {
+      if (!segment_meets_box(p, d, -reach, reach, master_boxes[static_cast<std::size_t>(mf)])) continue;
       const DirectionProjection pr = project_along_direction(master, mf, p, d, settings_.inside_tolerance);
       if (pr.kind != ProjectionKind::inside || pr.face_normal.dot(d) >= 0.0 || std::abs(pr.alpha) > settings_.search_margin) continue;
       if (pg.master < 0 || std::abs(pr.alpha) < std::abs(pg.gap)) pg.master = mf, pg.projection = pr, pg.gap = pr.alpha;
@@ -160,7 +163,7 @@ void SurfaceToSurfacePair::point_gap_derivatives(const ContactSurface& slave, co
     const int nm = master.faces()[static_cast<std::size_t>(pg.master)].count;
     direction_gap_derivatives(master, pg.master, pg.projection, d, derivatives > 1, gd);
     // v = (p, d, y_l) -> w = (x_k, n_k, y_l): p = Σ N_k x_k, d = m/|m|, m = Σ N_k n_k.
-    const int nw = 6 * nk + 3 * nm, nv = 6 + 3 * nm;
+    const int nw = 6 * nk + 3 * nm;
     const Mat3 P = Mat3::Identity() - d * d.transpose();
     const Vec3 a = gd.grad.segment<3>(3);
     pg.grad.setZero(nw);
@@ -170,13 +173,28 @@ void SurfaceToSurfacePair::point_gap_derivatives(const ContactSurface& slave, co
     }
     pg.grad.tail(3 * nm) = gd.grad.tail(3 * nm);
     if (derivatives < 2) continue;
-    Eigen::MatrixXd V = Eigen::MatrixXd::Zero(nv, nw);
+    // pg.hess = Vᵀ gd.hess V with V = ∂v/∂w block-structured: p → x_k by N_k I, d → n_k by
+    // (N_k/ρ) P, y_l by I. Formed block by block from the three v-blocks' products with P
+    // (Hpd P, P Hdd P, P Hdy), scaled by the shape values, instead of as dense products.
+    const Eigen::MatrixXd& Hv = gd.hess;
+    const Mat3 Hpp = Hv.block<3, 3>(0, 0), HpdP = Hv.block<3, 3>(0, 3) * P, PHddP = P * Hv.block<3, 3>(3, 3) * P;
+    const Eigen::MatrixXd Hpy = Hv.block(0, 6, 3, 3 * nm), PHdy = P * Hv.block(3, 6, 3, 3 * nm);
+    pg.hess.resize(nw, nw);
     for (int k = 0; k < nk; ++k) {
-      V.block<3, 3>(0, 3 * k) = sh.n[k] * Mat3::Identity();
-      V.block<3, 3>(3, 3 * nk + 3 * k) = sh.n[k] / rho * P;
+      const double nk_ = sh.n[k];
+      for (int l = 0; l < nk; ++l) {
+        const double nn = nk_ * sh.n[l];
+        pg.hess.block<3, 3>(3 * k, 3 * l) = nn * Hpp;
+        pg.hess.block<3, 3>(3 * k, 3 * nk + 3 * l) = (nn / rho) * HpdP;
+        pg.hess.block<3, 3>(3 * nk + 3 * l, 3 * k) = (nn / rho) * HpdP.transpose();
+        pg.hess.block<3, 3>(3 * nk + 3 * k, 3 * nk + 3 * l) = (nn / (rho * rho)) * PHddP;
+      }
+      pg.hess.block(3 * k, 6 * nk, 3, 3 * nm) = nk_ * Hpy;
+      pg.hess.block(6 * nk, 3 * k, 3 * nm, 3) = nk_ * Hpy.transpose();
+      pg.hess.block(3 * nk + 3 * k, 6 * nk, 3, 3 * nm) = (nk_ / rho) * PHdy;
+      pg.hess.block(6 * nk, 3 * nk + 3 * k, 3 * nm, 3) = (nk_ / rho) * PHdy.transpose();
     }
-    V.bottomRightCorner(3 * nm, 3 * nm).setIdentity();
-    pg.hess = V.transpose() * gd.hess * V;
+    pg.hess.bottomRightCorner(3 * nm, 3 * nm) = Hv.bottomRightCorner(3 * nm, 3 * nm);
     // Σ_c α_{d_c} ∂²d_c/∂m∂m = −[d (Pa)ᵀ + (Pa) dᵀ + (a·d) P] / ρ².
     const Vec3 Pa = P * a;
     const Mat3 S = -(d * Pa.transpose() + Pa * d.transpose() + a.dot(d) * P) / (rho * rho);
@@ -228,6 +246,8 @@ SurfaceToSurfacePair::NodeResult SurfaceToSurfacePair::assemble_node(const Conta
     for (int l = 0; l < mf.count; ++l) s.push_back(slot(master_x, mf.node[l]));
     return s;
   };
+  Eigen::VectorXd g_group;
+  Eigen::MatrixXd h_group;
   for (int pass = 0; pass < 2; ++pass) {
     Eigen::VectorXd G;
     Eigen::MatrixXd H;
@@ -236,21 +256,36 @@ SurfaceToSurfacePair::NodeResult SurfaceToSurfacePair::assemble_node(const Conta
       G.setZero(n);
       if (tangent) H.setZero(n, n);
     }
+    // The points of one slave face that hit the same master face share their variables:
+    // their weighted derivatives are summed in the face-local layout first (contiguous,
+    // vectorised) and moved into the node's slots once per such group.
     for (int fi : slave.node_faces(j)) {
       const SurfaceFace& f = slave.faces()[static_cast<std::size_t>(fi)];
       const int kj = local_index(f);
       const auto& rule = gauss_[static_cast<std::size_t>(fi)];
-      for (std::size_t q = 0; q < rule.size(); ++q) {
-        const PointGap& pg = gaps[static_cast<std::size_t>(fi)][q];
-        if (pg.master < 0) continue;
-        const std::vector<int> s = block_slots(f, pg.master);
+      const auto& face_gaps = gaps[static_cast<std::size_t>(fi)];
+      for (std::size_t first = 0; first < rule.size(); ++first) {
+        const int m = face_gaps[first].master;
+        if (m < 0) continue;
+        bool seen = false;  // a group is taken at its first point
+        for (std::size_t q = 0; q < first && !seen; ++q) seen = face_gaps[q].master == m;
+        if (seen) continue;
+        const std::vector<int> s = block_slots(f, m);
         if (pass == 0) continue;
-        const double c = rule[q].shape.n[kj] * rule[q].weight;
+        g_group.setZero(face_gaps[first].grad.size());
+        if (tangent) h_group.setZero(g_group.size(), g_group.size());
+        for (std::size_t q = first; q < rule.size(); ++q) {
+          const PointGap& pg = face_gaps[q];
+          if (pg.master != m) continue;
+          const double c = rule[q].shape.n[kj] * rule[q].weight;
+          g_group += c * pg.grad;
+          if (tangent) h_group += c * pg.hess;
+        }
         for (std::size_t a = 0; a < s.size(); ++a) {
-          G.segment<3>(3 * s[a]) += c * pg.grad.segment<3>(3 * static_cast<Eigen::Index>(a));
+          G.segment<3>(3 * s[a]) += g_group.segment<3>(3 * static_cast<Eigen::Index>(a));
           if (!tangent) continue;
           for (std::size_t b = 0; b < s.size(); ++b)
-            H.block<3, 3>(3 * s[a], 3 * s[b]) += c * pg.hess.block<3, 3>(3 * static_cast<Eigen::Index>(a), 3 * static_cast<Eigen::Index>(b));
+            H.block<3, 3>(3 * s[a], 3 * s[b]) += h_group.block<3, 3>(3 * static_cast<Eigen::Index>(a), 3 * static_cast<Eigen::Index>(b));
         }
       }
     }
@@ -282,11 +317,13 @@ SurfaceToSurfacePair::NodeResult SurfaceToSurfacePair::assemble_node(const Conta
     // (column slot, block) pairs — identity for the slave and master positions, the
     // nodal normal's Jacobian over its patch. Applied as Tᵀ G and Tᵀ (H T); T is
     // mostly identity blocks, so this is several times cheaper than dense products.
+    // Positions map to one column slot by identity (ident[v], no products); normals by their blocks.
     std::vector<std::vector<std::pair<int, Mat3>>> map(keys.size());
+    std::vector<int> ident(keys.size(), -1);
     for (std::size_t v = 0; v < keys.size(); ++v) {
       const VarKey& k = keys[v];
-      if (k.kind == slave_x) map[v].emplace_back(sslot(k.node), Mat3::Identity());
-      else if (k.kind == master_x) map[v].emplace_back(mslot(k.node), Mat3::Identity());
+      if (k.kind == slave_x) ident[v] = sslot(k.node);
+      else if (k.kind == master_x) ident[v] = mslot(k.node);
       else {
         const auto& nd = slave.normal_derivatives(k.node);
         for (std::size_t m = 0; m < nd.patch.size(); ++m)
@@ -294,8 +331,11 @@ SurfaceToSurfacePair::NodeResult SurfaceToSurfacePair::assemble_node(const Conta
       }
     }
     Eigen::VectorXd gD = Eigen::VectorXd::Zero(ndof);
-    for (std::size_t v = 0; v < keys.size(); ++v)
-      for (const auto& [col, J] : map[v]) gD.segment<3>(col) += J.transpose() * G.segment<3>(3 * static_cast<Eigen::Index>(v));
+    for (std::size_t v = 0; v < keys.size(); ++v) {
+      const auto vi = 3 * static_cast<Eigen::Index>(v);
+      if (ident[v] >= 0) gD.segment<3>(ident[v]) += G.segment<3>(vi);
+      for (const auto& [col, J] : map[v]) gD.segment<3>(col) += J.transpose() * G.segment<3>(vi);
+    }
     std::vector<GlobalDof> dofs;
     for (int n : snodes)
       for (int c = 0; c < 3; ++c) dofs.push_back(slave.dof(n, c));
@@ -305,11 +345,17 @@ SurfaceToSurfacePair::NodeResult SurfaceToSurfacePair::assemble_node(const Conta
     Eigen::MatrixXd K;
     if (tangent) {
       Eigen::MatrixXd HT = Eigen::MatrixXd::Zero(nvar, ndof);
-      for (std::size_t v = 0; v < keys.size(); ++v)
-        for (const auto& [col, J] : map[v]) HT.middleCols<3>(col) += H.middleCols<3>(3 * static_cast<Eigen::Index>(v)) * J;
+      for (std::size_t v = 0; v < keys.size(); ++v) {
+        const auto vi = 3 * static_cast<Eigen::Index>(v);
+        if (ident[v] >= 0) HT.middleCols<3>(ident[v]) += H.middleCols<3>(vi);
+        for (const auto& [col, J] : map[v]) HT.middleCols<3>(col).noalias() += H.middleCols<3>(vi) * J;
+      }
       Eigen::MatrixXd HD = Eigen::MatrixXd::Zero(ndof, ndof);
-      for (std::size_t v = 0; v < keys.size(); ++v)
-        for (const auto& [row, J] : map[v]) HD.middleRows<3>(row) += J.transpose() * HT.middleRows<3>(3 * static_cast<Eigen::Index>(v));
+      for (std::size_t v = 0; v < keys.size(); ++v) {
+        const auto vi = 3 * static_cast<Eigen::Index>(v);
+        if (ident[v] >= 0) HD.middleRows<3>(ident[v]) += HT.middleRows<3>(vi);
+        for (const auto& [row, J] : map[v]) HD.middleRows<3>(row).noalias() += J.transpose() * HT.middleRows<3>(vi);
+      }
       for (std::size_t v = 0; v < keys.size(); ++v) {
         if (keys[v].kind != slave_n) continue;
         const auto& nd = slave.normal_derivatives(keys[v].node);
@@ -323,7 +369,8 @@ SurfaceToSurfacePair::NodeResult SurfaceToSurfacePair::assemble_node(const Conta
               HD.block<3, 3>(s[a], s[b]) += gc * nd.hessian[static_cast<std::size_t>(c)].block<3, 3>(3 * static_cast<Eigen::Index>(a), 3 * static_cast<Eigen::Index>(b));
         }
       }
-      K = (d2 / A) * gD * gD.transpose() + d1 * HD;
+      K.noalias() = (d2 / A) * gD * gD.transpose();
+      K += d1 * HD;
     }
     out->add(dofs, R, K);
   }
@@ -372,12 +419,13 @@ void SurfaceToSurfacePair::assemble(const SystemState& state, Assembler& out) {
   // around an active node (most of the surface is out of contact most of the
   // time, and the Hessians are the expensive part).
   std::vector<std::vector<PointGap>> gaps(slave_->faces().size());
+  const std::vector<Eigen::AlignedBox3d> boxes = face_boxes(*master_);
   std::vector<char> done(slave_->faces().size(), 0);
   for (std::size_t j = 0; j < ns; ++j) {
     if (!state.owns(j, ns)) continue;
     for (int fi : slave_->node_faces(static_cast<int>(j))) {
       if (done[static_cast<std::size_t>(fi)]) continue;
-      point_gaps(*slave_, *master_, candidates_, fi, gaps[static_cast<std::size_t>(fi)]);
+      point_gaps(*slave_, *master_, candidates_, boxes, fi, gaps[static_cast<std::size_t>(fi)]);
       done[static_cast<std::size_t>(fi)] = 1;
     }
   }
@@ -434,9 +482,10 @@ SurfaceContactState SurfaceToSurfacePair::evaluate(const Eigen::VectorXd& u) con
   Candidates cand;
   search(slave, master, cand);
   std::vector<std::vector<PointGap>> gaps(slave.faces().size());
+  const std::vector<Eigen::AlignedBox3d> boxes = face_boxes(master);
   SurfaceContactState st;
   for (std::size_t f = 0; f < slave.faces().size(); ++f) {
-    point_gaps(slave, master, cand, static_cast<int>(f), gaps[f]);
+    point_gaps(slave, master, cand, boxes, static_cast<int>(f), gaps[f]);
     point_gap_derivatives(slave, master, static_cast<int>(f), 1, gaps[f]);
     const SurfaceFace& face = slave.faces()[f];
     for (std::size_t q = 0; q < gaps[f].size(); ++q) {

@@ -41,6 +41,8 @@
 // MPI: every rank searches everything and assembles the slave nodes of its
 // fixed partition (SystemState::owns over slave nodes), computing the
 // Gauss points of the faces around them.
+#include <Eigen/Geometry>
+
 #include <memory>
 #include <string>
 #include <vector>
@@ -146,8 +148,9 @@ class SurfaceToSurfacePair : public Term {
   /// Projects the Gauss points of slave face `face` (gap and hit master face
   /// only); point_gap_derivatives adds their derivatives (1: gradient, 2: and
   /// Hessian), which are needed only around active slave nodes.
-  void point_gaps(const ContactSurface& slave, const ContactSurface& master, const Candidates& cand, int face,
-                  std::vector<PointGap>& out) const;
+  /// `master_boxes`: face_boxes(master), which cull the candidates a point's ray cannot hit.
+  void point_gaps(const ContactSurface& slave, const ContactSurface& master, const Candidates& cand,
+                  const std::vector<Eigen::AlignedBox3d>& master_boxes, int face, std::vector<PointGap>& out) const;
   void point_gap_derivatives(const ContactSurface& slave, const ContactSurface& master, int face, int derivatives,
                              std::vector<PointGap>& points) const;
   /// Adds node j's residual (and tangent) at the current surfaces to `out`; returns the weighted gap.
