@@ -213,6 +213,7 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     write_phantom(spec, out_lumen_vtp, out_wall_vtp, cl, summary);
     if (out_true_centerline.empty()) std::filesystem::remove(cl);
     summary.set_text("input", "phantom");
+    summary.set_text("input_units", "mm");
     summary.set_text("wall_source", "phantom");
     return;
   }
@@ -223,6 +224,7 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
   bool have_wall = false;
   std::string lumen_name, wall_name, kind;
   SurfaceCheckOptions checks;
+  std::string input_units;  // the input files' length unit, for outputs in the input's units
   WallSynthesisOptions synthesis;
   if (const auto* sv = std::get_if<SimVascularInput>(&input.source)) {
     lumen_raw = loft_simvascular(sv->path, sv->lumen, sv->points_per_contour);
@@ -315,6 +317,7 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
       report_lesions(profile, summary, "tree_");  // along the whole extracted segment
     }
     lumen_name = tr->file.string() + " (extracted segment)";
+    input_units = tr->units;
     checks.units = "mm";  // already scaled
     checks.repair = tr->repair;
     synthesis = tr->synthesis;
@@ -332,6 +335,7 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
     synthesis = in.synthesis;
     kind = "surface";
   }
+  if (input_units.empty()) input_units = checks.units;
   SurfaceReport lr;
   TriSurface lumen = check_and_repair(std::move(lumen_raw), checks, lumen_name, lr);
   report_to_summary("lumen", lr, summary);
@@ -367,6 +371,7 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
   write_vtp(out_lumen_vtp.string(), lumen_out);
   write_vtp(out_wall_vtp.string(), to_output(wall, have_wall ? wall_name : "synthesized"));
   summary.set_text("input", kind);
+  summary.set_text("input_units", input_units);
   summary.set("lumen_triangles", double(lumen.num_triangles()));
   summary.set("wall_triangles", double(wall.num_triangles()));
   summary.set("lumen_surface_area", surface_area(lumen), "mm^2");

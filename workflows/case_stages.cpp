@@ -109,7 +109,7 @@ Stage segmentation_stage(const CaseConfig& c) {
   s.name = "segmentation";
   s.outputs = {"segmentation/lumen.vtp", "segmentation/wall.vtp"};
   s.config = slice(c, {"input", "stenosis"});
-  s.version = "2";  // 2: wall synthesized per section by the layer rule; ROI on the stenosis rule's lesions
+  s.version = "3";  // 3: input_units (the lumen_after surface is written in them); 2: wall synthesized per section by the layer rule; ROI on the stenosis rule's lesions
   const auto input = segmentation_input(c);
   if (input.is_phantom()) {
     s.outputs.push_back("segmentation/centerline_true.vtp");
