@@ -75,6 +75,7 @@ TEST_F(SolveStage, FreeExpansionRunsThroughSolveWithOnlyTheDevice) {
   EXPECT_NE(report.find(fmt::format("{:.4g}", d_max)), std::string::npos) << report;
   EXPECT_TRUE(fs::exists(work / "report/report.html"));
   EXPECT_TRUE(fs::exists(work / "report/figures/stent_diameter_vs_pressure.png"));
+  EXPECT_FALSE(fs::exists(work / "report/lumen_after.vtp"));  // no artery, no lumen
 
   // Only what the scene needs (DESIGN.md §3): the balloon and the stent, one beam-to-surface pair.
   const auto scene = stentsim::solver::read_scene(work / "solve/scene.yaml");
@@ -160,6 +161,20 @@ TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs
   const std::string w = stentsim::workflows::contact_face_size_warning(dir / "ga.work/mesh/artery.vtu", 0.25);
   EXPECT_NE(w.find("240 of 240 endothelium faces"), std::string::npos) << w;
   EXPECT_NE(w.find("artery.vtu"), std::string::npos) << w;
+
+  // Through the solve to the report: the deformed lumen after deflation, in mm (no input units: a generated artery).
+  const auto through = run_stentsim("run " + (dir / "ga.yaml").string());
+  ASSERT_EQ(through.code, 0) << through.out;
+  const fs::path rep = dir / "ga.work/report/summary.yaml";
+  EXPECT_EQ(summary_qoi(rep, "lumen_after_triangles"), 2 * 240);  // the 240 endothelium quads, two triangles each
+  EXPECT_EQ(summary_qoi(rep, "lumen_after_time"), 3.0);          // the end of the deflation
+  const auto lumen = stentsim::read_vtp((dir / "ga.work/report/lumen_after.vtp").string());
+  EXPECT_EQ(lumen.num_cells(), 480u);
+  double r_min = 1e9, r_max = 0.0;
+  for (const auto& p : lumen.points) r_min = std::min(r_min, std::hypot(p.x(), p.y())), r_max = std::max(r_max, std::hypot(p.x(), p.y()));
+  EXPECT_GT(r_min, 0.79);  // initial inner radius 0.8 mm: held at the cuts,
+  EXPECT_GT(r_max, 0.95);  // dilated where the stent stays (measured 1.049 mm)
+  EXPECT_EQ(fs::file_size(dir / "ga.work/report/lumen_after.stl"), 84u + 50u * 480u);
 
   // A patient scene: three layers (the intima as media), the warped balloon's frames from its own file, no
   // straight-balloon profile.
