@@ -1,4 +1,4 @@
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -12,13 +12,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <thread>
 
 #include "common/error.hpp"
 
 namespace fs = std::filesystem;
 
-namespace stentsim::pipeline {
+namespace stentsim::process {
 namespace {
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
@@ -182,4 +183,57 @@ ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start,
   return e;
 }
 
-}  // namespace stentsim::pipeline
+namespace {
+constexpr int kOutOfMemory = 3;  // the probe child's exit status when the read ran out of its memory budget
+
+// Caps the child's address space at what it maps now plus `budget` bytes, so a damaged
+// count fails there (std::bad_alloc) instead of taking the machine's memory. Not under
+// AddressSanitizer, whose shadow memory already exceeds any such cap.
+void cap_memory(double budget) {
+#if !defined(__SANITIZE_ADDRESS__)
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  unsigned long pages = 0;
+  if (!f) return;
+  const bool ok = std::fscanf(f, "%lu", &pages) == 1;
+  std::fclose(f);
+  if (!ok) return;
+  const double now = static_cast<double>(pages) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+  const rlimit cap{static_cast<rlim_t>(now + budget), static_cast<rlim_t>(now + budget)};
+  ::setrlimit(RLIMIT_AS, &cap);
+#else
+  (void)budget;
+#endif
+}
+}  // namespace
+
+void probe_read_in_child(const fs::path& file, const std::string& what, const std::function<void()>& read, double limit_s,
+                         double memory_bytes) {
+  ChildSetup quiet;
+  quiet.log = "/dev/null";
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t pid = spawn(
+      [&read, memory_bytes]() -> int {
+        cap_memory(memory_bytes);
+        try {
+          read();
+        } catch (const std::bad_alloc&) {
+          return kOutOfMemory;
+        } catch (...) {
+        }
+        return 0;
+      },
+      quiet);
+  const ChildEnd end = wait_with_limit(pid, start, limit_s);
+  if (end.exit_code == kOutOfMemory)
+    throw InputError(fmt::format("{}: the {} reader needs more than {:.0f} MB to read this file (a damaged count?)", file.string(),
+                                 what, memory_bytes / 1048576.0));
+  if (end.timed_out)
+    throw InputError(fmt::format("{}: the {} reader did not finish within {:.0f} s (a damaged file?)", file.string(), what, limit_s));
+  // The body returns 0 whatever it read: any other end is a crash (a signal, or the exit
+  // status of a handler that caught it, as a sanitizer's).
+  if (!end.ok())
+    throw InputError(fmt::format("{}: the {} reader crashed on this file ({}): is it damaged or cut short?", file.string(), what,
+                                 end.describe()));
+}
+
+}  // namespace stentsim::process

@@ -1,7 +1,8 @@
 #pragma once
 // Child processes for every runner that starts them: the stage runner (a
 // stage run in a forked child), the error study (stentsim runs, under mpirun
-// for ranks > 1) and the stability suite (cases under a wall-clock limit).
+// for ranks > 1), the stability suite (cases under a wall-clock limit) and the
+// readers that hand a user's file to a library that may crash on it.
 // One implementation of the parts they share:
 //  - fork into a process group of its own (pgid = pid), so that a runner can
 //    stop a child and everything it started (mpirun's ranks, gmsh) with one
@@ -24,7 +25,7 @@
 #include <utility>
 #include <vector>
 
-namespace stentsim::pipeline {
+namespace stentsim::process {
 
 struct ChildSetup {
   std::filesystem::path cwd;  ///< working folder of the child (empty: the parent's)
@@ -80,10 +81,20 @@ std::optional<Reaped> wait_any();
 /// by a timed-out child are killed too.
 ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start, double limit_s, double grace_s = 2.0);
 
+/// Runs `read` on `file` in a child first (its output discarded, its exceptions
+/// ignored: the caller's own read reports those) and throws InputError naming the
+/// file when the child dies by a signal (or exits non-zero: a crash handler's exit),
+/// is still reading after `limit_s` or needs more than `memory_bytes` beyond what
+/// the process has mapped (the child's address space is capped). For
+/// libraries that crash inside their own parsers on damaged input (VTK's XML
+/// readers), where no check before them can see what they will trip on.
+void probe_read_in_child(const std::filesystem::path& file, const std::string& what, const std::function<void()>& read,
+                         double limit_s = 20, double memory_bytes = 2.0 * 1024 * 1024 * 1024);
+
 /// Sends `sig` to the child's process group and to every live descendant.
 void signal_family(pid_t pid, int sig);
 
 /// Every live descendant of `root` (from the ppid fields of /proc/*/stat).
 std::vector<pid_t> descendants(pid_t root);
 
-}  // namespace stentsim::pipeline
+}  // namespace stentsim::process

@@ -55,9 +55,15 @@ struct MeshData {
 void write_vtu(const std::string& file, const MeshData& mesh);
 /// Writes poly data (.vtp): lines and polylines as lines, triangles/quads as polys. Atomic.
 void write_vtp(const std::string& file, const MeshData& mesh);
-/// Reads a .vtu. Throws InputError naming the file when it is not one.
+/// Reads a .vtu. Throws InputError naming the file when it is not one, when VTK's
+/// reader crashes on it (it is read in a child process first: check_vtk_xml_file)
+/// or when a cell refers past the points.
 MeshData read_vtu(const std::string& file);
-/// Reads a .vtp (lines become polylines, polygons triangles/quads).
+/// Reads a .vtp (lines become polylines, polygons triangles/quads); errors as read_vtu.
 MeshData read_vtp(const std::string& file);
+/// VTK 9.1's XML readers crash inside their own parser on some damaged files, past
+/// what a check before them can see: the file (.vtu or .vtp) is read in a child
+/// process first, and a crash or a hang there is an InputError naming the file.
+void check_vtk_xml_file(const std::string& file);
 
 }  // namespace stentsim

@@ -15,14 +15,21 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
+#include <vtkXMLReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include <filesystem>
+#include <fstream>
+#include <new>
+#include <tuple>
 
+#include "common/child_process.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/mesh_data.hpp"
+#include "common/vtk_read_errors.hpp"
+#include "common/vtk_smp.hpp"
 
 namespace stentsim {
 namespace {
@@ -105,6 +112,59 @@ void write_with(const std::string& file, Data* data) {
 
 void require_readable(const std::string& file) {
   if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: file not found", file));
+  if (!std::filesystem::is_regular_file(file))
+    throw InputError(fmt::format("{}: not a regular file (a folder, device or pipe); give the file itself", file));
+}
+
+// VTK's XML reader allocates what a piece's NumberOfPoints / NumberOfPolys ... say
+// before reading a byte of it: a damaged count means gigabytes (std::bad_alloc). Even
+// zlib-compressed data takes a byte per thousand values, so a count above 1000 x the
+// file's size is damage. The attributes precede the data: the first 64 kB are scanned.
+void check_xml_counts(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(65536, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const double limit = 1000.0 * static_cast<double>(std::filesystem::file_size(file)) + 1e6;
+  for (std::size_t at = head.find("NumberOf"); at != std::string::npos; at = head.find("NumberOf", at + 8)) {
+    const std::size_t eq = head.find("=\"", at);
+    if (eq == std::string::npos || eq > at + 40) continue;
+    const std::string name = head.substr(at, eq - at);
+    const double n = std::strtod(head.c_str() + eq + 2, nullptr);
+    if (n > limit || n < 0)
+      throw InputError(fmt::format("{}: {} = {:.0f} is more than a file of {} bytes can hold (damaged?)", file, name,
+                                   n, std::filesystem::file_size(file)));
+  }
+}
+
+// Runs an XML reader; its error events (a short array, bad offsets: it returns what it
+// read so far) and a failed allocation are InputErrors naming the file.
+void read_xml(vtkXMLReader* r, const std::string& file) {
+  vtkNew<VtkReadErrors> errors;
+  r->AddObserver(vtkCommand::ErrorEvent, errors);
+  r->SetFileName(file.c_str());
+  try {
+    r->Update();
+  } catch (const std::bad_alloc&) {
+    throw InputError(fmt::format("{}: the file asks for more memory than there is (a damaged count?)", file));
+  }
+  if (!errors->first.empty() || r->GetErrorCode() != 0)
+    throw InputError(fmt::format("{}: the file could not be read: {} (damaged or cut short?)", file,
+                                 errors->first.empty() ? "VTK error code " + std::to_string(r->GetErrorCode()) : errors->first));
+}
+
+// What VTK reads as it is from a damaged file: a cell that refers past the points, an
+// array with another tuple count than its points or cells.
+void check_read(const MeshData& m, const std::string& file) {
+  const auto n = static_cast<std::int64_t>(m.points.size());
+  for (std::size_t i = 0; i < m.connectivity.size(); ++i)
+    if (m.connectivity[i] < 0 || m.connectivity[i] >= n)
+      throw InputError(fmt::format("{}: a cell refers to point {}, but the file has {} points (damaged?)", file, m.connectivity[i], n));
+  for (const auto& [data, count, kind] : {std::tuple(&m.point_data, m.points.size(), "point"), std::tuple(&m.cell_data, m.num_cells(), "cell")})
+    for (const auto& [name, a] : *data)
+      if (a.components < 1 || a.values.size() != count * static_cast<std::size_t>(a.components))
+        throw InputError(fmt::format("{}: {} array '{}' holds {} values in {} components for {} {}s (damaged?)", file, kind, name,
+                                     a.values.size(), a.components, count, kind));
 }
 
 }  // namespace
@@ -164,13 +224,33 @@ void write_vtp(const std::string& file, const MeshData& m) {
   write_with<vtkXMLPolyDataWriter>(file, poly.GetPointer());
 }
 
-MeshData read_vtu(const std::string& file) {
+void check_vtk_xml_file(const std::string& file) {
   require_readable(file);
+  check_xml_counts(file);
+  const std::string ext = std::filesystem::path(file).extension().string();
+  process::probe_read_in_child(file, "VTK XML", [&] {
+    // The forked child has none of the parent's TBB worker threads: VTK's parallel loops
+    // would wait for them forever.
+    use_sequential_vtk_smp();
+    vtkSmartPointer<vtkXMLReader> r;
+    if (ext == ".vtp") r = vtkSmartPointer<vtkXMLPolyDataReader>::New();
+    else r = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
+    // VTK reports a failed allocation as an error event, not an exception: the probe
+    // turns it into one, so the file is refused instead of read again unbounded.
+    vtkNew<VtkReadErrors> errors;
+    r->AddObserver(vtkCommand::ErrorEvent, errors);
+    r->SetFileName(file.c_str());
+    r->Update();
+    if (errors->first.find("llocat") != std::string::npos) throw std::bad_alloc();
+  });
+}
+
+MeshData read_vtu(const std::string& file) {
+  check_vtk_xml_file(file);
   vtkNew<vtkXMLUnstructuredGridReader> r;
-  r->SetFileName(file.c_str());
-  r->Update();
+  read_xml(r, file);
   vtkUnstructuredGrid* g = r->GetOutput();
-  if (r->GetErrorCode() != 0 || !g) throw InputError(fmt::format("{}: not a readable VTU file", file));
+  if (!g) throw InputError(fmt::format("{}: not a readable VTU file", file));
   MeshData m;
   read_points(g, m);
   for (vtkIdType c = 0; c < g->GetNumberOfCells(); ++c) {
@@ -182,16 +262,16 @@ MeshData read_vtu(const std::string& file) {
   m.point_data = read_arrays(g->GetPointData());
   m.cell_data = read_arrays(g->GetCellData());
   m.field_text = read_field_text(g);
+  check_read(m, file);
   return m;
 }
 
 MeshData read_vtp(const std::string& file) {
-  require_readable(file);
+  check_vtk_xml_file(file);
   vtkNew<vtkXMLPolyDataReader> r;
-  r->SetFileName(file.c_str());
-  r->Update();
+  read_xml(r, file);
   vtkPolyData* p = r->GetOutput();
-  if (r->GetErrorCode() != 0 || !p) throw InputError(fmt::format("{}: not a readable VTP file", file));
+  if (!p) throw InputError(fmt::format("{}: not a readable VTP file", file));
   MeshData m;
   read_points(p, m);
   for (vtkIdType c = 0; c < p->GetNumberOfCells(); ++c) {
@@ -208,6 +288,7 @@ MeshData read_vtp(const std::string& file) {
   m.point_data = read_arrays(p->GetPointData());
   m.cell_data = read_arrays(p->GetCellData());
   m.field_text = read_field_text(p);
+  check_read(m, file);
   return m;
 }
 

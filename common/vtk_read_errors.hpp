@@ -3,14 +3,14 @@
 // return what they read so far (zeros for missing voxels, cells that refer past
 // their arrays). Observing the event, a reader's first error message is kept so
 // that the adapter can refuse the output and name the file. Included only by
-// the VTK adapter files (*_vtk.cpp).
+// the VTK adapter files (common/vtk_io.cpp, segmentation_io/*_vtk.cpp).
 #include <vtkCommand.h>
 #include <vtkObject.h>
 
 #include <algorithm>
 #include <string>
 
-namespace stentsim::segmentation {
+namespace stentsim {
 
 class VtkReadErrors : public vtkCommand {
  public:
@@ -25,4 +25,4 @@ class VtkReadErrors : public vtkCommand {
   std::string first;
 };
 
-}  // namespace stentsim::segmentation
+}  // namespace stentsim

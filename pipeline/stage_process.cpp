@@ -14,7 +14,7 @@
 #include "common/error.hpp"
 #include "common/log.hpp"
 #include "common/summary.hpp"
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 
 namespace stentsim::pipeline {
 namespace {
@@ -39,8 +39,8 @@ StageChild start_stage(const Stage& stage, const std::filesystem::path& work_dir
   try {
     // Its own process group (the runner stops the stage and anything it
     // started, mpirun or gmsh, together) and it dies with the runner, so no
-    // orphan keeps the work-folder lock: pipeline/child_process.hpp.
-    pid = spawn([&]() -> int {
+    // orphan keeps the work-folder lock: common/child_process.hpp.
+    pid = process::spawn([&]() -> int {
       ::close(fds[0]);
       const auto start = std::chrono::steady_clock::now();
       try {

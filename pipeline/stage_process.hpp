@@ -1,5 +1,5 @@
 #pragma once
-// Runs one stage in a child process (fork, pipeline/child_process.hpp): a
+// Runs one stage in a child process (fork, common/child_process.hpp): a
 // crash, an abort or a memory blow-up in a stage cannot take the runner
 // down, and wait4() gives the stage's peak memory. The child writes outputs
 // under temporary names only; a failure's message comes back through a pipe.

@@ -30,7 +30,7 @@
 #include "segmentation_io/image_header_checks.hpp"
 #include "segmentation_io/image_header_geometry.hpp"
 #include "segmentation_io/label_image.hpp"
-#include "segmentation_io/vtk_read_errors.hpp"
+#include "common/vtk_read_errors.hpp"
 
 namespace stentsim::segmentation {
 

@@ -23,7 +23,7 @@
 #include "segmentation_io/legacy_vtk_ascii.hpp"
 #include "segmentation_io/stl_binary.hpp"
 #include "segmentation_io/surface_input.hpp"
-#include "segmentation_io/vtk_read_errors.hpp"
+#include "common/vtk_read_errors.hpp"
 
 namespace stentsim::segmentation {
 
@@ -61,27 +61,6 @@ void check_point_indices(vtkPolyData* pd, const std::filesystem::path& file) {
   }
 }
 
-// VTK's XML reader allocates what a piece's NumberOfPoints / NumberOfPolys ... say
-// before reading a byte of it: a damaged count means gigabytes (std::bad_alloc). Even
-// zlib-compressed data takes a byte per thousand values, so a count above 1000 x the
-// file's size is damage. The attributes precede the data: the first 64 kB are scanned.
-void check_xml_counts(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::string head(65536, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  const double limit = 1000.0 * static_cast<double>(std::filesystem::file_size(file)) + 1e6;
-  for (std::size_t at = head.find("NumberOf"); at != std::string::npos; at = head.find("NumberOf", at + 8)) {
-    const std::size_t eq = head.find("=\"", at);
-    if (eq == std::string::npos || eq > at + 40) continue;
-    const std::string name = head.substr(at, eq - at);
-    const double n = std::strtod(head.c_str() + eq + 2, nullptr);
-    if (n > limit || n < 0)
-      throw InputError(fmt::format("{}: {} = {:.0f} is more than a file of {} bytes can hold (damaged?)", file.string(), name,
-                                   n, std::filesystem::file_size(file)));
-  }
-}
-
 }  // namespace
 
 TriSurface read_surface_file(const std::filesystem::path& file) {
@@ -92,7 +71,7 @@ TriSurface read_surface_file(const std::filesystem::path& file) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   vtkSmartPointer<vtkAlgorithm> reader;
   if (ext == ".vtp") {
-    check_xml_counts(file);
+    check_vtk_xml_file(file.string());
     auto r = vtkSmartPointer<vtkXMLPolyDataReader>::New();
     if (!r->CanReadFile(file.c_str()))
       throw InputError(fmt::format("{}: not a VTK XML PolyData (.vtp) file", file.string()));

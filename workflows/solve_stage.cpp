@@ -16,7 +16,7 @@
 #include "common/mesh_data.hpp"
 #include "common/mesh_tags.hpp"
 #include "device_gen/stent_design.hpp"
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 #include "solver/app/checkpoint.hpp"
 #include "solver/app/solve.hpp"
 #include "solver/io/scene.hpp"
@@ -453,14 +453,14 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
       }
     } else {
       std::vector<std::string> argv = mpi_launcher(cfg.simulation.ranks);
-      for (const std::string& a : {pipeline::self_executable().string(), std::string("solve"), run_scene.string(),
+      for (const std::string& a : {process::self_executable().string(), std::string("solve"), run_scene.string(),
                                   std::string("--out"), run.dir.string(), std::string("--checkpoint-every"),
                                   std::to_string(cfg.output.checkpoint_every)})
         argv.push_back(a);
       if (run.restart) argv.insert(argv.end(), {"--restart", run.restart->string()});
       const auto start = std::chrono::steady_clock::now();
-      const pid_t pid = pipeline::spawn_exec(argv);
-      const pipeline::ChildEnd end = pipeline::wait_with_limit(pid, start, 1e9);
+      const pid_t pid = process::spawn_exec(argv);
+      const process::ChildEnd end = process::wait_with_limit(pid, start, 1e9);
       if (!end.ok()) status = 1, mpi_end = end.describe();
       else ctx.summary() = Summary::read(run.dir / "summary.yaml");
       if (!face_warning.empty()) ctx.summary().note("warning_contact_face_size", face_warning);

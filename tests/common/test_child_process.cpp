@@ -1,4 +1,4 @@
-// pipeline/child_process: the one implementation of child processes that the
+// common/child_process: the one implementation of child processes that the
 // stage runner, the error study and the stability suite use. Small shell
 // commands: working folder, environment, log capture (truncate or append),
 // exit status, signal, CPU time and peak memory from wait4, and a function
@@ -13,10 +13,10 @@
 #include <sstream>
 
 #include "common/error.hpp"
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 
 namespace fs = std::filesystem;
-using namespace stentsim::pipeline;
+using namespace stentsim::process;
 
 namespace {
 

@@ -9,7 +9,7 @@
 
 #include "common/config.hpp"
 #include "common/error.hpp"
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 #include "pipeline/runner.hpp"
 #include "workflows/case_config.hpp"
 #include "workflows/case_stages.hpp"
@@ -133,7 +133,7 @@ void register_cohort(CLI::App& app) {
     o.dry_run = a->dry_run;
     o.workers = a->workers;
     o.only_cases = split(a->cases);
-    o.binary = pipeline::self_executable().string();
+    o.binary = process::self_executable().string();
     std::vector<std::pair<std::string, std::string>> stage_args;
     if (!a->until.empty()) stage_args.emplace_back("--until", a->until);
     if (!a->only.empty()) stage_args.emplace_back("--only", a->only);

@@ -7,7 +7,7 @@
 #include <iostream>
 
 #include "common/error.hpp"
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 #include "workflows/cli/commands.hpp"
 #include "workflows/study/error_study.hpp"
 #include "workflows/study/stability/stability_command.hpp"
@@ -41,7 +41,7 @@ void register_study(CLI::App& app) {
     o.yes = a->yes;
     o.reuse_timings = a->reuse;
     o.jobs = a->jobs;
-    o.binary = pipeline::self_executable().string();
+    o.binary = process::self_executable().string();
     return study::run_error_study(a->file, o, std::cout);
   });
   auto* stab = study->add_subcommand("stability", "Stiff and extreme cases: converge or fail cleanly (suite, outcome table)");

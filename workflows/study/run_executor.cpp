@@ -18,7 +18,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/summary.hpp"
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 #include "workflows/version.hpp"
 
 namespace fs = std::filesystem;
@@ -41,12 +41,12 @@ std::string tail_lines(const fs::path& file, std::size_t n) {
 }
 
 pid_t start_child(const std::vector<std::string>& args, const fs::path& log) {
-  pipeline::ChildSetup setup;
+  process::ChildSetup setup;
   setup.log = log;
   setup.append_log = true;  // the run's commands share run.log
   // One thread per rank: the core budget counts ranks.
   setup.env = {{"OMP_NUM_THREADS", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"}};
-  return pipeline::spawn_exec(args, setup);
+  return process::spawn_exec(args, setup);
 }
 
 void write_result(const fs::path& file, const RunResult& r) {
@@ -242,12 +242,12 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
         running.emplace(pid, std::move(r));
       }
       if (running.empty()) continue;
-      const auto reaped = pipeline::wait_any();
+      const auto reaped = process::wait_any();
       if (!reaped) continue;  // a signal: the loop checks the stop flag
       auto it = running.find(reaped->pid);
       if (it == running.end()) continue;
       Running& r = it->second;
-      const pipeline::ChildEnd end = pipeline::child_end(reaped->wait_status, reaped->usage, 0);
+      const process::ChildEnd end = process::child_end(reaped->wait_status, reaped->usage, 0);
       // wait4's rusage covers the child and its reaped descendants (mpirun's ranks):
       // CPU time is their sum, ru_maxrss the largest single process.
       r.cpu += end.cpu_s;

@@ -8,13 +8,13 @@ namespace stentsim::study {
 
 ChildRun run_child(const std::vector<std::string>& argv, const fs::path& cwd, const fs::path& log, double limit_s) {
   fs::create_directories(cwd);
-  pipeline::ChildSetup setup;
+  process::ChildSetup setup;
   setup.cwd = cwd;
   setup.log = log;
   setup.env = {{"OMP_NUM_THREADS", "1"}};
   const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = pipeline::spawn_exec(argv, setup);
-  return pipeline::wait_with_limit(pid, start, limit_s);
+  const pid_t pid = process::spawn_exec(argv, setup);
+  return process::wait_with_limit(pid, start, limit_s);
 }
 
 }  // namespace stentsim::study

@@ -1,6 +1,6 @@
 #pragma once
 // Runs one stability case's command as a child process under a wall-clock
-// limit (issue 11): pipeline/child_process.hpp does the work (own process
+// limit (issue 11): common/child_process.hpp does the work (own process
 // group, log capture, wait4 resource usage, SIGTERM then SIGKILL to the
 // child and everything it started at the limit). The raw facts are reported
 // here; stability_runner.hpp turns them into an outcome.
@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 
 namespace stentsim::study {
 
 /// exit_code, signal, timed_out, wall_s, cpu_s, peak_memory_mb of a case's run.
-using ChildRun = pipeline::ChildEnd;
+using ChildRun = process::ChildEnd;
 
 /// Runs argv[0] (a path; looked up in PATH only when it has no '/') with
 /// argv in `cwd`, output to `log` (truncated). After `limit_s` seconds the

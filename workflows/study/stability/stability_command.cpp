@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
-#include "pipeline/child_process.hpp"
+#include "common/child_process.hpp"
 #include "workflows/study/stability/stability_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -28,7 +28,7 @@ constexpr const char* kUsage =
 /// This executable, or empty when unknown (the suite search then starts at the working folder).
 fs::path self_executable() {
   try {
-    return pipeline::self_executable();
+    return process::self_executable();
   } catch (const ComputeError&) {
     return {};
   }
