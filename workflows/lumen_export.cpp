@@ -50,9 +50,15 @@ MeshData deformed_lumen(const std::filesystem::path& frame, const std::string& u
       case CellType::quadratic_triangle:  // corners 0 1 2, mid-side nodes 3 (0-1), 4 (1-2), 5 (2-0): VTK order
         tris = {{n[0], n[3], n[5]}, {n[3], n[1], n[4]}, {n[5], n[4], n[2]}, {n[3], n[4], n[5]}};
         break;
-      default: continue;  // volume cells carry no FaceGroup of a surface
+      case CellType::tetra:
+      case CellType::quadratic_tetra:
+      case CellType::hexahedron: continue;  // volume cells: their FaceGroup is 0 anyway
+      default:
+        throw InputError(fmt::format("{}: cell {} is tagged endothelium but is no triangle, quadratic triangle or quad", frame.string(), c));
     }
-    for (const auto& t : tris) out.add_cell(CellType::triangle, {point(t[0]), point(t[1]), point(t[2])});
+    // The mesh winds its faces with the normal out of the wall, into the lumen; a flow
+    // domain's boundary faces the other way (out of the fluid), so each triangle is reversed.
+    for (const auto& t : tris) out.add_cell(CellType::triangle, {point(t[0]), point(t[2]), point(t[1])});
   }
   if (out.num_cells() == 0)
     throw InputError(fmt::format("{}: no endothelium faces ({} = {}) in this artery frame", frame.string(), tags::kFaceGroup,

@@ -27,8 +27,7 @@ std::string targets_key(const CaseConfig& c) {
 /// The deformed lumen after deflation (the solve's last artery frame) for a flow
 /// simulation, in the input's units (segmentation/summary.yaml input_units; mm
 /// for a generated artery).
-void write_lumen_after(const std::filesystem::path& solve_dir, const std::filesystem::path& work_dir, bool segmented,
-                       pipeline::StageContext& ctx) {
+void write_lumen_after(const std::filesystem::path& solve_dir, bool segmented, pipeline::StageContext& ctx) {
   const auto frames = report::read_pvd(solve_dir / "results.pvd");
   const report::PvdFrame* last = nullptr;
   for (const auto& f : frames)
@@ -36,7 +35,7 @@ void write_lumen_after(const std::filesystem::path& solve_dir, const std::filesy
   if (!last) throw InputError(fmt::format("{}: no artery frame to take the lumen after deflation from", (solve_dir / "results.pvd").string()));
   std::string units = "mm";
   if (segmented) {
-    const std::filesystem::path seg = work_dir / "segmentation" / "summary.yaml";
+    const std::filesystem::path seg = ctx.input("segmentation/summary.yaml");
     const Summary s = report::read_summary(seg, "the segmentation stage");
     const auto it = s.qois().find("input_units");
     const std::string* text = it == s.qois().end() ? nullptr : std::get_if<std::string>(&it->second.value);
@@ -64,6 +63,7 @@ pipeline::Stage report_stage(const CaseConfig& c) {
     s.outputs.push_back("report/lumen_after.stl");
   }
   const bool segmented = c.scene == Scene::patient || c.placed;  // scenes with a segmentation stage
+  if (artery && segmented) s.inputs.push_back("segmentation/summary.yaml");  // input_units of lumen_after
   s.config = fmt::format("scene={};name={};simulation={}", to_string(c.scene), c.name, canonical_yaml(c.section("simulation")));
   s.version = "2";  // 2: lumen_after.vtp/.stl
   report::ReportInput in;
@@ -78,7 +78,7 @@ pipeline::Stage report_stage(const CaseConfig& c) {
     in.solve_dir = ctx.input("solve/summary.yaml").parent_path();
     report::write_report(in, ctx.output("report/report.md"), ctx.output("report/report.html"),
                          ctx.output("report/figures/"), ctx.summary());
-    if (artery) write_lumen_after(in.solve_dir, ctx.work_dir(), segmented, ctx);
+    if (artery) write_lumen_after(in.solve_dir, segmented, ctx);
   };
   return s;
 }

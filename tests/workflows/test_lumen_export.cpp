@@ -56,6 +56,13 @@ TEST(LumenExport, EndotheliumMovedSplitAndScaled) {
   }
   // The face (0,0),(1,0),(0,1) maps to (0,0),(1,2),(0,1) in the plane z = 0.5: area 1/2 · |det [[1, 0], [2, 1]]| = 1/2.
   EXPECT_NEAR(area, 0.5, 1e-12);
+  // The mesh's face 0-1-2 has its normal along +z (out of its tet, into the lumen); the lumen's triangles face the other way.
+  for (std::size_t c = 0; c < mm.num_cells(); ++c) {
+    const auto n = mm.cell(c);
+    const Eigen::Vector3d a = mm.points[static_cast<std::size_t>(n[0])], b = mm.points[static_cast<std::size_t>(n[1])],
+                          d = mm.points[static_cast<std::size_t>(n[2])];
+    EXPECT_LT((b - a).cross(d - a).z(), 0.0) << "triangle " << c;
+  }
   // In cm: every coordinate a tenth.
   const MeshData cm = deformed_lumen(dir / "artery_00003.vtu", "cm");
   ASSERT_EQ(cm.points.size(), mm.points.size());
@@ -75,6 +82,12 @@ TEST(LumenExport, AFrameWithoutEndotheliumIsNamed) {
   const fs::path dir = fs::temp_directory_path() / ("stentsim_lumen_none_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   MeshData m = frame();
+  m.cell_types[1] = CellType::line;  // a cell tagged endothelium that is no face
+  m.cell_offsets = {0, 10, 12, 18};
+  m.connectivity = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 0, 1, 1, 2, 3, 5, 9, 8};
+  write_vtu((dir / "line.vtu").string(), m);
+  EXPECT_THROW(deformed_lumen(dir / "line.vtu", "mm"), InputError);
+  m = frame();
   m.cell_data[tags::kFaceGroup].values[1] = tags::outer_wall;
   write_vtu((dir / "a.vtu").string(), m);
   try {

@@ -2,6 +2,8 @@
 // scene it writes (only what the scene needs; re-runnable by hand with
 // `stentsim solve`), the quantities it reports and what makes it stale.
 #include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -174,6 +176,13 @@ TEST_F(SolveStage, GenericArterySceneHasTheArteryThreePhasesAndThreeContactPairs
   for (const auto& p : lumen.points) r_min = std::min(r_min, std::hypot(p.x(), p.y())), r_max = std::max(r_max, std::hypot(p.x(), p.y()));
   EXPECT_GT(r_min, 0.79);  // initial inner radius 0.8 mm: held at the cuts,
   EXPECT_GT(r_max, 0.95);  // dilated where the stent stays (measured 1.049 mm)
+  for (std::size_t c = 0; c < lumen.num_cells(); ++c) {  // normals out of the lumen, into the wall
+    const auto n = lumen.cell(c);
+    const Eigen::Vector3d a = lumen.points[static_cast<std::size_t>(n[0])], b = lumen.points[static_cast<std::size_t>(n[1])],
+                          d = lumen.points[static_cast<std::size_t>(n[2])];
+    const Eigen::Vector3d centre = (a + b + d) / 3.0;
+    EXPECT_GT((b - a).cross(d - a).dot(Eigen::Vector3d(centre.x(), centre.y(), 0.0)), 0.0) << "triangle " << c;
+  }
   EXPECT_EQ(fs::file_size(dir / "ga.work/report/lumen_after.stl"), 84u + 50u * 480u);
 
   // A patient scene: three layers (the intima as media), the warped balloon's frames from its own file, no
