@@ -110,7 +110,7 @@ HistoryArchive HistoryArchive::read(const std::filesystem::path& file) {
     const auto n = r.raw<std::uint64_t>();
     if (n > (data.size() - r.at) / sizeof(double)) r.need(data.size() + 1);  // truncated (or a damaged count)
     std::vector<double> v(n);
-    std::memcpy(v.data(), data.data() + r.at, n * sizeof(double));
+    if (n > 0) std::memcpy(v.data(), data.data() + r.at, n * sizeof(double));  // an empty vector's data() may be null
     r.at += n * sizeof(double);
     a.arrays_[key] = std::move(v);
   }
