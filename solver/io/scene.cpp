@@ -380,6 +380,11 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
     if (!std::filesystem::is_regular_file(xml)) li.fail("amg_parameters", fmt::format("no such file: {}", xml.string()));
     scene.linear.amg_parameters = xml.string();
   }
+  if (li.has("preconditioner_update")) {
+    if (scene.linear.type == LinearSolverType::direct || scene.linear.type == LinearSolverType::eigen_lu)
+      li.fail("preconditioner_update", "applies to the Krylov types (gmres_ilu, gmres_amg, gmres_amg_block) only");
+    scene.linear.lag_preconditioner = li.choice("preconditioner_update", {"lagged", "every_solve"}, "lagged") == "lagged";
+  }
   li.finish();
   s.finish();
 

@@ -41,6 +41,10 @@ struct LinearSolverSettings {
   int amg_equations_per_node = 3;
   /// gmres_amg: a MueLu XML parameter list applied over ours (empty: none).
   std::string amg_parameters;
+  /// Krylov solvers on one rank: keep the preconditioner of an earlier matrix
+  /// (lagged) while the GMRES time it costs beyond a fresh one's rate has not
+  /// yet paid for a new set-up; false: a new set-up for every matrix.
+  bool lag_preconditioner = true;
   int verbosity = 0;
 };
 
@@ -54,6 +58,8 @@ struct LinearSolveStats {
   int amg_levels = 0;
   /// A preconditioner (AMG hierarchy, ILU factors) was built afresh for this solve, not kept.
   bool preconditioner_built = false;
+  /// The preconditioner of an earlier matrix served this solve unchanged (lag_preconditioner).
+  bool preconditioner_lagged = false;
 };
 
 class LinearSolver {

@@ -29,6 +29,7 @@
 #include "common/error.hpp"
 #include "common/log.hpp"
 #include "solver/linalg/block_split.hpp"
+#include "solver/linalg/lag_policy.hpp"
 #include "solver/linalg/linear_solver.hpp"
 #include "solver/linalg/umfpack_factor.hpp"
 
@@ -230,46 +231,52 @@ class TrilinosSolver : public LinearSolver {
       stats.setup_seconds = seconds(t0, Clock::now()) - stats.solve_seconds;  // matrix, gather, factorization, broadcast
       return stats;
     }
-    {
-      RCP<OP> prec;
-      if (block) {
-        prec = block_preconditioner(a, map, stats);
-        if (!reuse) kept_.keep(mat, a);
-      } else if (reuse) {
-        if (auto ilu = Teuchos::rcp_dynamic_cast<Ifpack2::Preconditioner<SC, LO, GO, NO>>(kept_prec_)) {
-          ilu->compute();
-        } else {
-          auto amg = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(kept_prec_, true);
-          if (!reuse_amg(mat, *amg)) kept_prec_ = make_preconditioner(mat, map, stats, true);
-          stats.amg_levels = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(kept_prec_, true)
-                                 ->GetHierarchy()->GetNumLevels();
-        }
-        prec = kept_prec_;
-      } else {
-        prec = make_preconditioner(mat, map, stats, keep);
-        if (keep) {
-          kept_prec_ = prec;
-          kept_.keep(mat, a);
-        }
-      }
-      const auto t1 = Clock::now();
-      auto problem = rcp(new Belos::LinearProblem<SC, MV, OP>(mat, xv, bv));
-      problem->setRightPrec(prec);
-      if (!problem->setProblem()) throw std::runtime_error("Belos: could not set up the linear problem");
-      auto params = rcp(new Teuchos::ParameterList);
-      params->set("Num Blocks", settings_.krylov_size);
-      params->set("Maximum Iterations", settings_.max_iterations);
-      params->set("Maximum Restarts", std::max(1, settings_.max_iterations / std::max(1, settings_.krylov_size)));
-      params->set("Convergence Tolerance", std::max(settings_.tolerance, requested_tolerance_));
-      params->set("Verbosity", settings_.verbosity > 0 ? Belos::Errors + Belos::Warnings + Belos::FinalSummary
-                                                        : Belos::Errors);
-      Belos::BlockGmresSolMgr<SC, MV, OP> gmres(problem, params);
-      const auto result = gmres.solve();
-      stats.iterations = gmres.getNumIters();
-      stats.converged = result == Belos::Converged;
-      stats.setup_seconds = seconds(t0, t1);
-      stats.solve_seconds = seconds(t1, Clock::now());
+    // A lagged preconditioner (lag_preconditioner, LagPolicy): AMG's hierarchy (with its
+    // smoothers and coarse operators) or ILU's factors as the last set-up left them.
+    // gmres_amg_block lags block 1's AMG only, which works on any matrix of the same size
+    // (its matrix is its own copy); gmres_amg's and gmres_ilu's are bound to the kept
+    // matrix, so they serve only a matrix of its pattern.
+    const bool lag = settings_.lag_preconditioner && keep && lag_.may_lag() && (block ? bool(block_amg_) : reuse && kept_prec_);
+    RCP<OP> prec;
+    const auto tp = Clock::now();
+    if (lag) {
+      prec = block ? block_preconditioner(a, map, stats, false) : kept_prec_;
+      stats.preconditioner_lagged = true;
+      if (block && !reuse) kept_.keep(mat, a);
+    } else {
+      prec = fresh_preconditioner(a, mat, map, reuse, keep, stats);
     }
+    auto t1 = Clock::now();
+    stats.setup_seconds = seconds(t0, t1);
+    const double tolerance = std::max(settings_.tolerance, requested_tolerance_);
+    GmresResult g = gmres(mat, prec, xv, bv, lag ? lag_.iteration_cap(tolerance, settings_.max_iterations) : settings_.max_iterations,
+                          tolerance);
+    stats.solve_seconds = seconds(t1, Clock::now());
+    if (lag && !g.converged) {
+      // The lagged preconditioner no longer serves this matrix: a fresh one, and GMRES goes
+      // on from where the lagged solve stopped (to the rest of the tolerance, relative to
+      // the residual it starts from), so the lagged iterations are not lost.
+      log::debug("GMRES with the lagged preconditioner stopped at {:.2e} after {} iterations; going on with a fresh one",
+                 g.achieved, g.iterations);
+      const auto t2 = Clock::now();
+      stats.preconditioner_lagged = false;
+      prec = fresh_preconditioner(a, mat, map, true, keep, stats);  // lagging implies the matrix is kept
+      const auto t3 = Clock::now();
+      const GmresResult first = g;
+      const double rest = first.achieved > tolerance ? tolerance / first.achieved : 1.0;
+      g = gmres(mat, prec, xv, bv, settings_.max_iterations, rest);
+      lag_.built(block ? block_amg_seconds_ : seconds(t2, t3), g.iterations, g.achieved, seconds(t3, Clock::now()));
+      g.iterations += first.iterations;
+      g.achieved *= first.achieved;
+      stats.setup_seconds += seconds(t2, t3);
+      stats.solve_seconds += seconds(t3, Clock::now());
+    } else if (!lag) {
+      lag_.built(block ? block_amg_seconds_ : seconds(tp, t1), g.iterations, g.achieved, stats.solve_seconds);
+    } else {
+      lag_.lagged(g.iterations, g.achieved, stats.solve_seconds);
+    }
+    stats.iterations = g.iterations;
+    stats.converged = g.converged;
     // Relative residual, and the full solution on every rank.
     MV r(map, 1);
     mat->apply(*xv, r);
@@ -288,6 +295,60 @@ class TrilinosSolver : public LinearSolver {
   }
 
  private:
+  struct GmresResult {
+    int iterations = 0;
+    bool converged = false;
+    double achieved = 1.0;  // Belos's achieved relative residual
+  };
+
+  // GMRES from the guess in `x` to `tolerance` relative to its initial residual.
+  GmresResult gmres(const RCP<Matrix>& mat, const RCP<OP>& prec, const RCP<MV>& x, const RCP<MV>& b, int max_iterations,
+                    double tolerance) const {
+    auto problem = rcp(new Belos::LinearProblem<SC, MV, OP>(mat, x, b));
+    problem->setRightPrec(prec);
+    if (!problem->setProblem()) throw std::runtime_error("Belos: could not set up the linear problem");
+    auto params = rcp(new Teuchos::ParameterList);
+    params->set("Num Blocks", settings_.krylov_size);
+    params->set("Maximum Iterations", max_iterations);
+    params->set("Maximum Restarts", std::max(1, max_iterations / std::max(1, settings_.krylov_size)));
+    params->set("Convergence Tolerance", tolerance);
+    params->set("Verbosity", settings_.verbosity > 0 ? Belos::Errors + Belos::Warnings + Belos::FinalSummary : Belos::Errors);
+    Belos::BlockGmresSolMgr<SC, MV, OP> solver(problem, params);
+    GmresResult r;
+    r.converged = solver.solve() == Belos::Converged;
+    r.iterations = solver.getNumIters();
+    r.achieved = solver.achievedTol();
+    return r;
+  }
+
+  // A preconditioner set up for `mat` (values of `a`): built, or (`reuse`: the
+  // matrix is the kept one, refilled) the kept one recomputed from the new values.
+  RCP<OP> fresh_preconditioner(const CsrMatrix& a, const RCP<Matrix>& mat, const RCP<const Map>& map, bool reuse, bool keep,
+                               LinearSolveStats& stats) {
+    if (settings_.type == LinearSolverType::gmres_amg_block) {
+      RCP<OP> prec = block_preconditioner(a, map, stats, true);
+      if (!reuse) kept_.keep(mat, a);
+      return prec;
+    }
+    if (reuse) {
+      if (auto ilu = Teuchos::rcp_dynamic_cast<Ifpack2::Preconditioner<SC, LO, GO, NO>>(kept_prec_)) {
+        ilu->compute();
+      } else {
+        auto amg = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(kept_prec_, true);
+        if (!reuse_amg(mat, *amg)) kept_prec_ = make_preconditioner(mat, map, stats, true);
+        stats.amg_levels = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(kept_prec_, true)
+                               ->GetHierarchy()->GetNumLevels();
+      }
+      return kept_prec_;
+    }
+    RCP<OP> prec = make_preconditioner(mat, map, stats, keep);
+    if (keep) {
+      kept_prec_ = prec;
+      kept_.keep(mat, a);
+    }
+    return prec;
+  }
+
   RCP<Matrix> build_matrix(const CsrMatrix& a, const RCP<const Map>& map) const {
     // Capacity per owned row: the sum over ranks of their entries in it (an
     // upper bound of the union that fillComplete assembles).
@@ -362,29 +423,35 @@ class TrilinosSolver : public LinearSolver {
 
   // gmres_amg_block: split, AMG on block 1 (its prolongators kept while its
   // pattern stays, as gmres_amg's), UMFPACK on block 2 (its analysis kept likewise).
-  RCP<OP> block_preconditioner(const CsrMatrix& a, const RCP<const Map>& map, LinearSolveStats& stats) {
+  // `refresh_amg` false: block 1's AMG as it is (lagged; the split and block 2's
+  // LU are always this matrix's: the balloon and the stent change most between
+  // iterations, and their exact block solve is what keeps GMRES short).
+  RCP<OP> block_preconditioner(const CsrMatrix& a, const RCP<const Map>& map, LinearSolveStats& stats, bool refresh_amg) {
     if (block_end_ <= block_begin_)
       throw std::logic_error("gmres_amg_block: no AMG block was set (set_amg_block)");
     split_ = split_blocks(a, block_begin_, block_end_);
-    // The AMG's A11 keeps the pattern its hierarchy was built on (amg_matrix, block_split.hpp).
-    bool same = block_amg_ && block_.matrix && amg_values_on(split_.a11, block_.row_ptr, block_.cols, amg_values_);
-    RCP<const Map> map1;
-    if (same) {
-      block_.refill(amg_values_);
-      same = reuse_amg(block_.matrix, *block_amg_);
-      map1 = block_.matrix->getRowMap();
-    }
-    if (!same) {
-      const CsrMatrix m11 = amg_matrix(split_.a11);
-      map1 = rcp(new Map(static_cast<GO>(m11.rows), 0, comm_));
-      RCP<Matrix> m = build_matrix(m11, map1);
-      block_amg_ = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(
-          make_preconditioner(m, map1, stats, true), true);
-      block_.keep(m, m11);
+    if (refresh_amg || !block_amg_) {
+      const auto t0 = Clock::now();
+      // The AMG's A11 keeps the pattern its hierarchy was built on (amg_matrix, block_split.hpp).
+      bool same = block_amg_ && block_.matrix && amg_values_on(split_.a11, block_.row_ptr, block_.cols, amg_values_);
+      if (same) {
+        block_.refill(amg_values_);
+        same = reuse_amg(block_.matrix, *block_amg_);
+        block_map_ = block_.matrix->getRowMap();
+      }
+      if (!same) {
+        const CsrMatrix m11 = amg_matrix(split_.a11);
+        block_map_ = rcp(new Map(static_cast<GO>(m11.rows), 0, comm_));
+        RCP<Matrix> m = build_matrix(m11, block_map_);
+        block_amg_ = Teuchos::rcp_dynamic_cast<MueLu::TpetraOperator<SC, LO, GO, NO>>(
+            make_preconditioner(m, block_map_, stats, true), true);
+        block_.keep(m, m11);
+      }
+      block_amg_seconds_ = seconds(t0, Clock::now());
     }
     stats.amg_levels = block_amg_->GetHierarchy()->GetNumLevels();
     block_lu_.factor(split_.a22);
-    return rcp(new BlockGaussSeidel(map, map1, block_amg_, split_, block_lu_));
+    return rcp(new BlockGaussSeidel(map, block_map_, block_amg_, split_, block_lu_));
   }
 
   // The kept hierarchy's prolongators with the new values (MueLu reuse RP).
@@ -523,10 +590,13 @@ class TrilinosSolver : public LinearSolver {
   KeptMatrix block_;
   std::vector<double> amg_values_;  // block 1's AMG matrix values (scratch, kept for its capacity)
   RCP<MueLu::TpetraOperator<SC, LO, GO, NO>> block_amg_;
+  RCP<const Map> block_map_;  // block 1's map (its AMG's)
+  double block_amg_seconds_ = 0.0;  // the last set-up of block 1's AMG
   UmfpackFactor block_lu_{false};  // no iterative refinement: GMRES corrects the block solve
   Eigen::MatrixXd modes_;
   Eigen::MatrixXd coordinates_;       // set_node_coordinates
   double requested_tolerance_ = 0.0;  // set_relative_tolerance
+  LagPolicy lag_;
 };
 
 }  // namespace

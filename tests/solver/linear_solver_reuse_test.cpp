@@ -50,12 +50,15 @@ CsrMatrix grid_matrix(int n, double skew, bool extra_coupling = false, double wx
   return a;
 }
 
-// Scalar AMG (constant near-null space) solved to 1e-10, for the grid matrices.
-LinearSolverSettings scalar_amg(LinearSolverType type) {
+// Scalar AMG (constant near-null space) solved to 1e-10, for the grid matrices;
+// `lag`: the preconditioner may be lagged (the tests of what a set-up keeps set it
+// up for every matrix).
+LinearSolverSettings scalar_amg(LinearSolverType type, bool lag = false) {
   LinearSolverSettings s;
   s.type = type;
   s.amg_equations_per_node = 1;
   s.tolerance = 1e-10;
+  s.lag_preconditioner = lag;
   return s;
 }
 
@@ -132,6 +135,7 @@ TEST(IluReuse, RefilledMatrixAndRecomputedIluMatchAFreshSolver) {
   s.type = LinearSolverType::gmres_ilu;
   s.ilu_fill = 1;  // an inexact ILU, so the preconditioner's values matter
   s.tolerance = 1e-10;
+  s.lag_preconditioner = false;
   const auto kept = make_linear_solver(s);
   Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(1728, -1, 2);
   int differing_iterations = 0, previous = -1;
@@ -257,4 +261,51 @@ TEST(AmgBlockReuse, ReservedEntriesThatFillKeepTheHierarchy) {
     EXPECT_LE(st_kept.iterations, 1.5 * st_fresh.iterations + 2) << "skew " << skew;
   }
   EXPECT_EQ(built, 1) << "the hierarchy of the first solve serves the filled couplings too";
+}
+
+// Lagging (LinearSolverSettings::lag_preconditioner, lag_policy.hpp): the solve
+// after a set-up keeps that preconditioner whatever the timings (nothing has been
+// spent on it yet), and every lagged solve still reaches the tolerance on the
+// current matrix. A matrix the lagged preconditioner no longer serves (the
+// anisotropy turned 50:1) would take more GMRES iterations than max_iterations
+// allows: that solve is repeated with a fresh set-up and converges.
+TEST(LaggedPreconditioner, LaggedSolvesReachTheToleranceAndAFailedOneIsRepeatedFresh) {
+  for (const LinearSolverType type : {LinearSolverType::gmres_amg, LinearSolverType::gmres_amg_block}) {
+    const bool block = type == LinearSolverType::gmres_amg_block;
+    LinearSolverSettings s = scalar_amg(type, true);
+    s.max_iterations = 40;
+    const auto solver = make_linear_solver(s);
+    if (block) solver->set_amg_block(0, 3000);
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3375, -1, 2);
+    int lagged = 0;
+    struct Case { double skew, wx, wz; };
+    const std::vector<Case> cases{{0.0, 1, 1}, {0.02, 1, 1}, {0.04, 1, 1}, {0.06, 1, 1}, {0.1, 1, 50}};
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+      const CsrMatrix a = grid_matrix(15, cases[k].skew, false, cases[k].wx, cases[k].wz);
+      Eigen::VectorXd x;
+      const auto st = solver->solve(a, b, x);
+      std::printf("%s, matrix %zu: %d GMRES iterations%s%s\n", block ? "block" : "amg", k, st.iterations,
+                  st.preconditioner_lagged ? " (lagged)" : "", st.preconditioner_built ? " (built)" : "");
+      ASSERT_TRUE(st.converged) << "matrix " << k;
+      EXPECT_LT((a.multiply(x) - b).norm() / b.norm(), 1e-9) << "matrix " << k;
+      if (k == 0) {
+        EXPECT_FALSE(st.preconditioner_lagged);
+      } else if (k == 1) {
+        EXPECT_TRUE(st.preconditioner_lagged) << "the solve after a set-up keeps it";
+      }
+      lagged += st.preconditioner_lagged ? 1 : 0;
+      if (k + 1 == cases.size()) {
+        // A fresh solver needs far fewer than max_iterations here; the one set up for the
+        // isotropic matrix would not reach the tolerance within them.
+        const auto fresh = make_linear_solver(s);
+        if (block) fresh->set_amg_block(0, 3000);
+        Eigen::VectorXd y;
+        const auto st_fresh = fresh->solve(a, b, y);
+        ASSERT_TRUE(st_fresh.converged);
+        EXPECT_FALSE(st.preconditioner_lagged) << "the turned matrix is solved with a fresh set-up";
+        EXPECT_GT(st.iterations, st_fresh.iterations) << "its count includes the lagged attempt";
+      }
+    }
+    EXPECT_GE(lagged, 1);
+  }
 }

@@ -145,6 +145,9 @@ TEST(SolverScene, BadInputNamesFileAndKey) {
   // MueLu parameters only for gmres_amg, and only from a file that exists.
   expect_error("type: direct", "type: direct, amg_parameters: muelu.xml", "amg_parameters: applies to types gmres_amg and gmres_amg_block only");
   expect_error("type: direct", "type: gmres_amg, amg_parameters: muelu.xml", "amg_parameters: no such file");
+  // Preconditioner lagging only for the Krylov types, with one of its two values.
+  expect_error("type: direct", "type: direct, preconditioner_update: lagged", "preconditioner_update: applies to the Krylov types");
+  expect_error("type: direct", "type: gmres_amg, preconditioner_update: sometimes", "preconditioner_update");
   std::filesystem::remove_all(dir);
 }
 
