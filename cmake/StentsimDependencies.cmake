@@ -40,6 +40,10 @@ stentsim_require(CLI11_FOUND libcli11-dev "CLI11")
 
 find_package(Threads REQUIRED)
 
+# oneTBB: the solver's threaded element loops (solver/assembly/threads.cpp).
+find_package(TBB QUIET)
+stentsim_require(TBB_FOUND libtbb-dev "oneTBB")
+
 # xxHash ships no CMake config in Debian 12.
 stentsim_plain_library(stentsim_xxhash xxhash.h xxhash libxxhash-dev "xxHash")
 

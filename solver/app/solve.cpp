@@ -13,6 +13,7 @@
 #include "solver/app/checkpoint.hpp"
 #include "solver/app/run_observer.hpp"
 #include "solver/assembly/parallel.hpp"
+#include "solver/assembly/threads.hpp"
 #include "solver/beams/beam_output.hpp"
 #include "solver/io/results_writer.hpp"
 #include "solver/io/scene_kinds.hpp"
@@ -60,7 +61,9 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   model.ranks = parallel::size();
   const bool writes = model.rank == 0;
   if (!writes) log::set_level(log::Level::warn);
-  log::info("linear solver: {}; {} MPI rank(s)", linear->describe(), model.ranks);
+  // Threads of the element loops: the option, else $STENTSIM_THREADS, else this node's cores over the ranks.
+  const AssemblyThreads threads(options.threads ? *options.threads : default_assembly_threads(model.ranks));
+  log::info("linear solver: {}; {} MPI rank(s), {} assembly thread(s) per rank", linear->describe(), model.ranks, assembly_threads());
   if (linear_settings.type == LinearSolverType::direct && model.ranks > 1)
     log::info("direct solver on {} ranks: the assembled matrix is gathered on rank 0 and factored there with "
               "UMFPACK (serial; memory and time of one rank); use gmres_ilu or gmres_amg for large models", model.ranks);
@@ -189,6 +192,7 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
   summary.set("floor_steps", static_cast<double>(counters.floor_steps));
   if (counters.floor_steps > 0) summary.set("worst_floor_residual", counters.worst_floor);
   summary.set("dofs", static_cast<double>(model.dofs.size()));
+  summary.set("assembly_threads", static_cast<double>(assembly_threads()));
   summary.set("final_time", t_last, "s");
   summary.note("scene", file);
   summary.note("linear_solver", linear->describe());

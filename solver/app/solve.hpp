@@ -27,6 +27,9 @@ struct SolveOptions {
   std::optional<std::filesystem::path> restart;
   /// Overrides output.checkpoint_every of the scene (the case's solve stage sets its own).
   std::optional<int> checkpoint_every;
+  /// Threads of the element loops per rank (threads.hpp); none: $STENTSIM_THREADS, else
+  /// the cores over the ranks. Not part of the scene: the results agree to round-off.
+  std::optional<int> threads;
 };
 
 /// Runs a parsed scene (the case pipeline calls this in-process). Returns 0 on

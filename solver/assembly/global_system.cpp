@@ -2,6 +2,7 @@
 
 #include "common/log.hpp"
 #include "solver/assembly/parallel.hpp"
+#include "solver/assembly/threads.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -23,7 +24,10 @@ void GlobalSystem::begin(const Eigen::VectorXd& prescribed, bool with_tangent) {
   with_tangent_ = with_tangent;
   std::fill(matrix_.values.begin(), matrix_.values.end(), 0.0);
   pending_.clear();
+  laying_.clear();
 }
+
+bool GlobalSystem::pattern_laid(const void* term) const { return std::find(laid_.begin(), laid_.end(), term) != laid_.end(); }
 
 void GlobalSystem::insert(GlobalDof row, GlobalDof col, double value) {
   const auto k = matrix_.find(row, col);
@@ -31,8 +35,9 @@ void GlobalSystem::insert(GlobalDof row, GlobalDof col, double value) {
   else pending_.emplace_back(row, col, value);
 }
 
-void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& r_in,
-                       const Eigen::Ref<const Eigen::MatrixXd>& k_in) {
+template <class Hold>
+void GlobalSystem::scatter(Scratch& scratch, std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& r_in,
+                           const Eigen::Ref<const Eigen::MatrixXd>& k_in, Hold&& hold) {
   const auto n = static_cast<Eigen::Index>(dofs.size());
   const bool tangent = with_tangent_ && k_in.size() > 0;
   // Nodal frames: rotate node triples of the element to local coordinates.
@@ -47,23 +52,23 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
   Eigen::Ref<const Eigen::VectorXd> rr = r_in;
   Eigen::Ref<const Eigen::MatrixXd> kr = k_in;
   if (rotate) {
-    r_scratch_ = r_in;
-    if (tangent) k_scratch_ = k_in;
+    scratch.r = r_in;
+    if (tangent) scratch.k = k_in;
     for (Eigen::Index i = 0; i + 2 < n; ++i) {
       const GlobalDof d = dofs[static_cast<std::size_t>(i)];
       if (d < 0 || !constraints_.frame_start(d) || dofs[static_cast<std::size_t>(i) + 1] != d + 1 ||
           dofs[static_cast<std::size_t>(i) + 2] != d + 2)
         continue;
       const Mat3& q = *constraints_.frame(d);
-      r_scratch_.segment<3>(i) = q.transpose() * r_scratch_.segment<3>(i);
+      scratch.r.segment<3>(i) = q.transpose() * scratch.r.segment<3>(i);
       if (tangent) {
-        k_scratch_.middleRows<3>(i) = q.transpose() * k_scratch_.middleRows<3>(i);
-        k_scratch_.middleCols<3>(i) = k_scratch_.middleCols<3>(i) * q;
+        scratch.k.middleRows<3>(i) = q.transpose() * scratch.k.middleRows<3>(i);
+        scratch.k.middleCols<3>(i) = scratch.k.middleCols<3>(i) * q;
       }
       i += 2;
     }
-    r = &r_scratch_;
-    k = &k_scratch_;
+    r = &scratch.r;
+    k = &scratch.k;
   }
   auto rv = [&](Eigen::Index i) { return r ? (*r)(i) : rr(i); };
   auto kv = [&](Eigen::Index i, Eigen::Index j) { return k ? (*k)(i, j) : kr(i, j); };
@@ -77,32 +82,69 @@ void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const E
   // The block's free columns in DOF order, so that each row is one forward walk
   // through its sorted CSR columns (a node's x, y, z are neighbours there)
   // instead of a binary search per entry; fixed columns go to the correction.
-  free_cols_.clear();
-  fixed_cols_.clear();
+  scratch.free_cols.clear();
+  scratch.fixed_cols.clear();
   for (Eigen::Index j = 0; j < n; ++j) {
     const GlobalDof gj = dofs[static_cast<std::size_t>(j)];
     if (gj < 0) continue;
-    (constraints_.fixed(gj) ? fixed_cols_ : free_cols_).emplace_back(gj, j);
+    (constraints_.fixed(gj) ? scratch.fixed_cols : scratch.free_cols).emplace_back(gj, j);
   }
-  std::sort(free_cols_.begin(), free_cols_.end());
+  std::sort(scratch.free_cols.begin(), scratch.free_cols.end());
   const std::int64_t* cols = matrix_.cols.data();
   for (Eigen::Index i = 0; i < n; ++i) {
     const GlobalDof gi = dofs[static_cast<std::size_t>(i)];
     if (gi < 0 || constraints_.fixed(gi)) continue;
-    for (const auto& [gj, j] : fixed_cols_) correction_(gi) += kv(i, j) * prescribed_(gj);
+    for (const auto& [gj, j] : scratch.fixed_cols) correction_(gi) += kv(i, j) * prescribed_(gj);
     std::int64_t pos = matrix_.row_ptr[static_cast<std::size_t>(gi)];
     const std::int64_t end = matrix_.row_ptr[static_cast<std::size_t>(gi) + 1];
-    for (const auto& [gj, j] : free_cols_) {
+    for (const auto& [gj, j] : scratch.free_cols) {
       if (pos < end && cols[pos] < gj && (++pos < end && cols[pos] < gj)) pos = std::lower_bound(cols + pos, cols + end, gj) - cols;
       if (pos < end && cols[pos] == gj) matrix_.values[static_cast<std::size_t>(pos)] += kv(i, j);
-      else pending_.emplace_back(gi, gj, kv(i, j));
+      else hold(gi, gj, kv(i, j));
     }
   }
+}
+
+void GlobalSystem::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& r_in,
+                       const Eigen::Ref<const Eigen::MatrixXd>& k_in) {
+  scatter(scratch_, dofs, r_in, k_in, [this](GlobalDof i, GlobalDof j, double v) { pending_.emplace_back(i, j, v); });
+  if (pending_.size() > compact_at_) compact_pending();
+}
+
+ConcurrentAssembler* GlobalSystem::concurrent() {
+  const auto n = static_cast<std::size_t>(assembly_threads());
+  while (lanes_.size() < n) lanes_.emplace_back(*this);
+  return this;
+}
+
+Assembler& GlobalSystem::lane(int thread, std::size_t order) {
+  Lane& l = lanes_.at(static_cast<std::size_t>(thread));
+  l.order = order;
+  return l;
+}
+
+void GlobalSystem::Lane::add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& r_in,
+                             const Eigen::Ref<const Eigen::MatrixXd>& k_in) {
+  system_->scatter(scratch, dofs, r_in, k_in, [this](GlobalDof i, GlobalDof j, double v) { held.emplace_back(order, i, j, v); });
+}
+
+void GlobalSystem::merge() {
+  std::vector<std::tuple<std::size_t, GlobalDof, GlobalDof, double>> all;
+  for (Lane& l : lanes_) {
+    all.insert(all.end(), l.held.begin(), l.held.end());
+    l.held.clear();
+  }
+  if (all.empty()) return;
+  // In block order, and inside a block as its lane added them: the serial add()'s order
+  // over the coloured sequence, whichever thread took which block.
+  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
+  pending_.reserve(pending_.size() + all.size());
+  for (const auto& [order, i, j, v] : all) pending_.emplace_back(i, j, v);
   if (pending_.size() > compact_at_) compact_pending();
 }
 
 void GlobalSystem::compact_pending() {
-  std::sort(pending_.begin(), pending_.end(), [](const auto& a, const auto& b) {
+  std::stable_sort(pending_.begin(), pending_.end(), [](const auto& a, const auto& b) {
     return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) < std::get<0>(b) : std::get<1>(a) < std::get<1>(b);
   });
   std::size_t out = 0;
@@ -139,7 +181,8 @@ void GlobalSystem::finish() {
     matrix_.values.clear();
     for (GlobalDof i = 0; i < n; ++i) {
       auto& row = rows[static_cast<std::size_t>(i)];
-      std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      // Stable: a repeated entry sums in the order it was added, as inside the pattern.
+      std::stable_sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       for (std::size_t k = 0; k < row.size(); ++k) {
         if (k > 0 && row[k].first == row[k - 1].first) {
           matrix_.values.back() += row[k].second;
@@ -158,6 +201,8 @@ void GlobalSystem::finish() {
   }
   for (GlobalDof d = 0; d < n; ++d)
     if (constraints_.fixed(d)) matrix_.values[static_cast<std::size_t>(matrix_.find(d, d))] = rank_ == 0 ? 1.0 : 0.0;
+  laid_.insert(laid_.end(), laying_.begin(), laying_.end());
+  laying_.clear();
 }
 
 double GlobalSystem::free_residual_norm() const {

@@ -9,6 +9,8 @@
 // a new coupling (contact).
 #include <Eigen/Core>
 
+#include <span>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -18,7 +20,7 @@
 
 namespace stentsim::solver {
 
-class GlobalSystem : public Assembler {
+class GlobalSystem : public Assembler, private ConcurrentAssembler {
  public:
   explicit GlobalSystem(const Constraints& constraints);
 
@@ -28,6 +30,9 @@ class GlobalSystem : public Assembler {
   void add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& residual,
            const Eigen::Ref<const Eigen::MatrixXd>& tangent) override;
   bool wants_tangent() const override { return with_tangent_; }
+  /// Threaded element loops add through lanes (ConcurrentAssembler): one per thread
+  /// of assembly_threads(), made on the first call.
+  ConcurrentAssembler* concurrent() override;
   /// This rank among `ranks`: residuals are summed over ranks in finish(),
   /// the identity on fixed rows comes from rank 0 only.
   void set_parallel(int rank, int ranks) { rank_ = rank, ranks_ = ranks; }
@@ -52,6 +57,37 @@ class GlobalSystem : public Assembler {
 
  private:
   void insert(GlobalDof row, GlobalDof col, double value);
+  // What one thread needs to scatter a block: rotated copies for nodal frames and
+  // the block's columns, (DOF, local index), free and fixed. Grows, never shrinks:
+  // no per-element allocation.
+  struct Scratch {
+    Eigen::VectorXd r;
+    Eigen::MatrixXd k;
+    std::vector<std::pair<GlobalDof, Eigen::Index>> free_cols, fixed_cols;
+  };
+  // Adds a block; `hold(row, col, value)` takes entries outside the pattern.
+  template <class Hold>
+  void scatter(Scratch& scratch, std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& residual,
+               const Eigen::Ref<const Eigen::MatrixXd>& tangent, Hold&& hold);
+  // A thread's sink in a threaded loop: entries outside the pattern wait, tagged
+  // with their block's order, for merge().
+  class Lane : public Assembler {
+   public:
+    explicit Lane(GlobalSystem& system) : system_(&system) {}
+    void add(std::span<const GlobalDof> dofs, const Eigen::Ref<const Eigen::VectorXd>& residual,
+             const Eigen::Ref<const Eigen::MatrixXd>& tangent) override;
+    bool wants_tangent() const override { return system_->with_tangent_; }
+    GlobalSystem* system_;
+    std::size_t order = 0;
+    Scratch scratch;
+    std::vector<std::tuple<std::size_t, GlobalDof, GlobalDof, double>> held;
+  };
+  Assembler& lane(int thread, std::size_t order) override;
+  void merge() override;
+  bool pattern_laid(const void* term) const override;
+  void laid(const void* term) override { laying_.push_back(term); }
+  std::vector<Lane> lanes_;
+  std::vector<const void*> laying_, laid_;  // terms whose pattern this assembly lays; has laid
 
   const Constraints& constraints_;
   Eigen::VectorXd residual_, correction_, prescribed_, magnitude_;
@@ -64,10 +100,7 @@ class GlobalSystem : public Assembler {
   std::size_t compact_at_ = std::size_t{1} << 22;
   bool with_tangent_ = true;
   int rank_ = 0, ranks_ = 1;
-  // scratch for frame rotations (grows, never shrinks: no per-element allocation)
-  Eigen::VectorXd r_scratch_;
-  Eigen::MatrixXd k_scratch_;
-  std::vector<std::pair<GlobalDof, Eigen::Index>> free_cols_, fixed_cols_;  // add()'s columns: (DOF, local index)
+  Scratch scratch_;  // add()'s
 };
 
 }  // namespace stentsim::solver

@@ -4,6 +4,8 @@
 
 #include <array>
 #include <limits>
+#include <mutex>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -11,7 +13,10 @@
 #include <numbers>
 
 #include "common/error.hpp"
+#include "common/log.hpp"
+#include "solver/assembly/colouring.hpp"
 #include "solver/assembly/parallel.hpp"
+#include "solver/assembly/threads.hpp"
 #include "solver/terms/element_failure.hpp"
 #include "solver/terms/solid_kernel.hpp"
 
@@ -120,20 +125,83 @@ void SolidBody::assemble_element(const Element& el, const SystemState& state, As
   else out.add(dofs, r, Eigen::MatrixXd());
 }
 
+void SolidBody::assemble_any(const Element& el, const SystemState& state, Assembler& out, bool tangent) {
+  switch (mesh_.cell_types[el.cell]) {
+    case CellType::hexahedron: assemble_element<fem::Hex8>(el, state, out, tangent); break;
+    case CellType::tetra: assemble_element<fem::Tet4>(el, state, out, tangent); break;
+    case CellType::quadratic_tetra: assemble_element<fem::Tet10>(el, state, out, tangent); break;
+    default: break;
+  }
+}
+
+void SolidBody::colour_chunks() {
+  const std::size_t n = elements_.size();
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::int64_t> nodes;
+  chunk_colours_ = colour_by_nodes(chunks, mesh_.points.size(), [&](std::size_t c) {
+    nodes.clear();
+    for (std::size_t e = c * kChunk; e < std::min(n, (c + 1) * kChunk); ++e) {
+      const std::size_t cell = elements_[e].cell;
+      nodes.insert(nodes.end(), mesh_.connectivity.begin() + mesh_.cell_offsets[cell],
+                   mesh_.connectivity.begin() + mesh_.cell_offsets[cell + 1]);
+    }
+    return std::span<const std::int64_t>(nodes);
+  });
+  chunk_order_.assign(chunks, 0);
+  std::size_t order = 0;
+  for (const auto& colour : chunk_colours_)
+    for (const std::uint32_t c : colour) {
+      chunk_order_[c] = order;
+      order += std::min(n, (c + 1) * kChunk) - c * kChunk;
+    }
+  log::debug("body '{}': {} elements in {} chunks of {}, {} colours (threaded assembly)", name_, n, chunks, kChunk,
+             chunk_colours_.size());
+}
+
 void SolidBody::assemble(const SystemState& state, Assembler& out) {
   rank_ = state.rank, ranks_ = state.ranks;
   const bool tangent = out.wants_tangent();
   const std::size_t n = elements_.size();
-  for (std::size_t e = 0; e < n; ++e) {
-    if (!state.owns(e, n)) continue;
-    const Element& el = elements_[e];
-    switch (mesh_.cell_types[el.cell]) {
-      case CellType::hexahedron: assemble_element<fem::Hex8>(el, state, out, tangent); break;
-      case CellType::tetra: assemble_element<fem::Tet4>(el, state, out, tangent); break;
-      case CellType::quadratic_tetra: assemble_element<fem::Tet10>(el, state, out, tangent); break;
-      default: break;
-    }
+  ConcurrentAssembler* lanes = assembly_threads() > 1 ? out.concurrent() : nullptr;
+  if (!lanes || !lanes->pattern_laid(this)) {
+    for (std::size_t e = 0; e < n; ++e)
+      if (state.owns(e, n)) assemble_any(elements_[e], state, out, tangent);
+    if (lanes && tangent) lanes->laid(this);
+    return;
   }
+  // Threaded: runs of consecutive elements (chunks) are coloured by the nodes they
+  // share, so the chunks of one colour scatter into disjoint rows, each chunk in element
+  // order (neighbouring elements share rows: a chunk keeps them in cache, where
+  // colouring single elements would send every block to rows no other nearby block
+  // touches). Every matrix entry is summed in the coloured order whatever the thread
+  // count (colouring.hpp). A failing element stops the loop after its colour; the
+  // first in that order is reported, as the serial loop reports the first in its own.
+  if (chunk_colours_.empty()) colour_chunks();
+  std::mutex failure_mutex;
+  std::size_t failure_order = std::numeric_limits<std::size_t>::max();
+  std::string failure;
+  for (const auto& colour : chunk_colours_) {
+    parallel_ranges(colour.size(), 1, [&](std::size_t begin, std::size_t end) {
+      const int thread = assembly_thread_index();
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::size_t chunk = colour[i];
+        const std::size_t e0 = chunk * kChunk, e1 = std::min(n, e0 + kChunk);
+        for (std::size_t e = e0; e < e1; ++e) {
+          if (!state.owns(e, n)) continue;
+          const std::size_t order = chunk_order_[chunk] + (e - e0);
+          try {
+            assemble_any(elements_[e], state, lanes->lane(thread, order), tangent);
+          } catch (const ElementFailure& f) {
+            const std::lock_guard<std::mutex> lock(failure_mutex);
+            if (order < failure_order) failure_order = order, failure = f.what();
+            return;
+          }
+        }
+      }
+    });
+    if (!failure.empty()) throw ElementFailure(failure);
+  }
+  lanes->merge();
 }
 
 void SolidBody::commit() {

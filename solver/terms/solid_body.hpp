@@ -4,6 +4,7 @@
 // and owns the viscous history of its quadrature points. Surface loads and
 // springs on the body are separate terms that read its node DOFs.
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,7 @@ class SolidBody : public Term {
   };
   template <class E>
   void assemble_element(const Element& el, const SystemState& state, Assembler& out, bool tangent);
+  void assemble_any(const Element& el, const SystemState& state, Assembler& out, bool tangent);
   template <class E>
   void cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& cauchy, Mat3& strain, double& max_principal) const;
   [[noreturn]] void fail(const Element& el, const char* type, int point, const char* why) const;
@@ -92,6 +94,12 @@ class SolidBody : public Term {
   GlobalDof first_dof_;
   std::vector<ViscousHistory> committed_, trial_;
   int rank_ = 0, ranks_ = 1;  // element partition of the last assembly
+  // Threaded assembly (made on first use): chunks of kChunk consecutive elements_,
+  // their colours, and each chunk's first element's place in the coloured order.
+  static constexpr std::size_t kChunk = 64;
+  void colour_chunks();
+  std::vector<std::vector<std::uint32_t>> chunk_colours_;
+  std::vector<std::size_t> chunk_order_;
 };
 
 }  // namespace stentsim::solver

@@ -38,6 +38,8 @@ struct SystemState {
   }
 };
 
+class ConcurrentAssembler;
+
 /// Receives element contributions; the global assembly sums them.
 class Assembler {
  public:
@@ -49,6 +51,30 @@ class Assembler {
                    const Eigen::Ref<const Eigen::MatrixXd>& tangent) = 0;
   /// Adds a residual only (for terms evaluated without tangent, e.g. reactions).
   virtual bool wants_tangent() const { return true; }
+  /// Sinks for a threaded element loop, or null: this assembler takes blocks from one thread.
+  virtual ConcurrentAssembler* concurrent() { return nullptr; }
+};
+
+/// Element blocks from several threads at once (threads.hpp, colouring.hpp). Each
+/// thread adds through its own lane; blocks added at the same time through
+/// different lanes share no row (the term colours its elements so). `order` is
+/// the block's place in a sequence that does not depend on the threads: what a
+/// lane holds back (entries outside the matrix pattern) joins the assembly in
+/// that order at merge(), so the result is the same for any thread count.
+class ConcurrentAssembler {
+ public:
+  virtual ~ConcurrentAssembler() = default;
+  /// Thread `thread`'s sink (0 <= thread < the loop's thread count) for the block numbered `order`.
+  virtual Assembler& lane(int thread, std::size_t order) = 0;
+  /// After the loop, in one thread.
+  virtual void merge() = 0;
+  /// A threaded loop needs the matrix pattern of its blocks laid (entries outside it
+  /// wait in memory until merge()): a term assembles serially, through the
+  /// Assembler itself, until a finished tangent assembly has laid its pattern.
+  /// laid(term) says that term's serial tangent blocks were all added; the pattern
+  /// counts as laid once that assembly is finished.
+  virtual bool pattern_laid(const void* term) const = 0;
+  virtual void laid(const void* term) = 0;
 };
 
 class Term {

@@ -492,6 +492,7 @@ TEST_F(Cohort, LocalWorkersRunWithOneThreadPerLibrary) {
     EXPECT_NE(env.find("\nVTK_SMP_BACKEND_IN_USE=Sequential\n"), std::string::npos) << env;
     EXPECT_EQ(env.find("VTK_SMP_BACKEND_IN_USE=TBB"), std::string::npos) << env;
     EXPECT_NE(env.find("\nVTK_SMP_MAX_THREADS=1\n"), std::string::npos) << env;
+    EXPECT_NE(env.find("\nSTENTSIM_THREADS=1\n"), std::string::npos) << env;  // the solver's element loops
     EXPECT_NE(env.find("\nHOME="), std::string::npos) << env;  // the rest of the environment is kept
   }
   const auto single = single_thread_environment();

@@ -9,6 +9,7 @@ void register_solve(CLI::App& app) {
   struct Args {
     std::string scene, out, linear, restart;
     int checkpoint_every = -1;
+    int threads = 0;
     bool verbose = false;
   };
   auto a = std::make_shared<Args>();
@@ -23,6 +24,9 @@ void register_solve(CLI::App& app) {
                       ->expected(0, 1);
   sub->add_option("--checkpoint-every", a->checkpoint_every, "Write checkpoint.bin every N steps (overrides output.checkpoint_every)")
       ->check(CLI::Range(0, 1000000));
+  sub->add_option("--threads", a->threads,
+                  "Threads of the element loops per rank (default: $STENTSIM_THREADS, else the cores over the ranks)")
+      ->check(CLI::Range(1, 1024));
   on(sub, [a, restart] {
     solver::SolveOptions o;
     o.output_dir = a->out;
@@ -30,6 +34,7 @@ void register_solve(CLI::App& app) {
     o.verbose = a->verbose;
     if (restart->count() > 0) o.restart = std::filesystem::path(a->restart);
     if (a->checkpoint_every >= 0) o.checkpoint_every = a->checkpoint_every;
+    if (a->threads > 0) o.threads = a->threads;
     // solve_scene returns non-zero when the computation could not finish
     // (last converged state written); the CLI's code for that is 1.
     return solver::solve_scene(a->scene, o) == 0 ? 0 : 1;

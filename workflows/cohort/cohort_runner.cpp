@@ -239,7 +239,7 @@ std::vector<std::size_t> selected_cases(const CohortConfig& c, const std::vector
 
 std::vector<std::pair<std::string, std::string>> single_thread_environment() {
   return {{"OMP_NUM_THREADS", "1"}, {"OPENBLAS_NUM_THREADS", "1"}, {"VTK_SMP_BACKEND_IN_USE", "Sequential"},
-          {"VTK_SMP_MAX_THREADS", "1"}};
+          {"VTK_SMP_MAX_THREADS", "1"}, {"STENTSIM_THREADS", "1"}};
 }
 
 int concurrent_cases(int workers, int ranks_per_case, int cores) {

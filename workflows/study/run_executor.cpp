@@ -45,7 +45,7 @@ pid_t start_child(const std::vector<std::string>& args, const fs::path& log) {
   setup.log = log;
   setup.append_log = true;  // the run's commands share run.log
   // One thread per rank: the core budget counts ranks.
-  setup.env = {{"OMP_NUM_THREADS", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"}};
+  setup.env = {{"OMP_NUM_THREADS", "1"}, {"STENTSIM_THREADS", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"}};
   return process::spawn_exec(args, setup);
 }
 
