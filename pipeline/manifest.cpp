@@ -15,6 +15,24 @@ std::string utc_now_iso8601() {
   return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now())));
 }
 
+const char* to_string(ErrorKind k) {
+  switch (k) {
+    case ErrorKind::none: return "none";
+    case ErrorKind::input: return "input";
+    case ErrorKind::compute: return "compute";
+    case ErrorKind::crash: return "crash";
+    case ErrorKind::interrupted: return "interrupted";
+    case ErrorKind::unknown: break;
+  }
+  return "unknown";
+}
+
+ErrorKind error_kind_from(std::string_view name) {
+  for (ErrorKind k : {ErrorKind::none, ErrorKind::input, ErrorKind::compute, ErrorKind::crash, ErrorKind::interrupted})
+    if (name == to_string(k)) return k;
+  return ErrorKind::unknown;
+}
+
 Manifest Manifest::load(const std::filesystem::path& file) {
   Manifest m;
   if (!std::filesystem::exists(file)) return m;
@@ -33,6 +51,7 @@ Manifest Manifest::load(const std::filesystem::path& file) {
       r.duration_s = n["duration_s"].as<double>(0.0);
       r.peak_memory_mb = n["peak_memory_mb"].as<double>(0.0);
       r.message = n["message"].as<std::string>("");
+      r.error_kind = r.status == "ok" ? ErrorKind::none : error_kind_from(n["error_kind"].as<std::string>(""));
       m.stages_[kv.first.as<std::string>()] = std::move(r);
     }
   } catch (const YAML::Exception& e) {
@@ -57,6 +76,7 @@ void Manifest::save(const std::filesystem::path& file) const {
     out << YAML::Key << "duration_s" << YAML::Value << r.duration_s;
     out << YAML::Key << "peak_memory_mb" << YAML::Value << r.peak_memory_mb;
     if (!r.message.empty()) out << YAML::Key << "message" << YAML::Value << r.message;
+    if (r.status != "ok") out << YAML::Key << "error_kind" << YAML::Value << to_string(r.error_kind);
     out << YAML::EndMap;
   }
   out << YAML::EndMap << YAML::EndMap;

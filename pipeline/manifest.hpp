@@ -5,8 +5,18 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace stentsim::pipeline {
+
+/// Why a stage failed: a bad input (the stage exited 2 on an InputError: the
+/// user fixes a file or a setting), a computation that did not complete (exit 1),
+/// a crash (a signal other than an interrupt), an interrupt. `unknown` is a
+/// failed record that does not say (written before kinds were recorded).
+enum class ErrorKind { none, input, compute, crash, interrupted, unknown };
+const char* to_string(ErrorKind k);
+/// The kind a manifest names; anything else is `unknown`.
+ErrorKind error_kind_from(std::string_view name);
 
 struct StageRecord {
   std::string status;  // "ok" or "failed"
@@ -18,6 +28,7 @@ struct StageRecord {
   double duration_s = 0;
   double peak_memory_mb = 0;
   std::string message;  // failure message
+  ErrorKind error_kind = ErrorKind::none;  // a failed record's kind
 };
 
 class Manifest {

@@ -168,6 +168,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       for (const auto& declared : plan_.outputs(r.stage))
         if (!fs::exists(r.temp_dir / declared)) {
           o.ok = false;
+          o.error_kind = ErrorKind::compute;
           o.message = fmt::format("did not write its declared output {}", declared);
           break;
         }
@@ -220,13 +221,17 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
     } else {
       rec.status = "failed";
       rec.message = o.message;
+      rec.error_kind = o.error_kind;
       manifest.set(s.name, rec);
       manifest.save(manifest_file());
       report.failed.push_back(s.name);
-      if (report.first_failure.empty()) report.first_failure = fmt::format("{}: {}", s.name, o.message);
+      if (report.first_failure.empty()) {
+        report.first_failure = fmt::format("{}: {}", s.name, o.message);
+        report.first_failure_kind = o.error_kind;
+      }
       failing = !options.keep_going;
       unusable.insert(r.stage);
-      out << fmt::format("  FAIL  {:<13} {}\n", s.name, o.message);
+      out << fmt::format("  FAIL  {:<13} {}{}\n", s.name, o.error_kind == ErrorKind::input ? "bad input: " : "", o.message);
       out << fmt::format("        log: {}\n", (plan_.work_dir() / "logs" / (s.name + ".log")).string());
       if (kept_partial) out << fmt::format("        partial outputs: {}\n", kept.string());
     }

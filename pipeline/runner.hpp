@@ -40,6 +40,7 @@ struct RunReport {
   std::vector<std::string> blocked;  // not run: they need a failed stage (keep_going)
   bool interrupted = false;
   std::string first_failure;  // "stage: message"
+  ErrorKind first_failure_kind = ErrorKind::none;
   /// 0 success, 1 a stage failed, 130 interrupted.
   int exit_code() const { return interrupted ? 130 : failed.empty() ? 0 : 1; }
 };

@@ -54,11 +54,16 @@ StageChild start_stage(const Stage& stage, const std::filesystem::path& work_dir
         ctx.summary().write(ctx.output(summary_output(stage.name)));
         log::info("finished in {:.2f} s", wall);
         child_exit(fds[1], 0, "");
+      } catch (const InputError& e) {
+        // Exit codes as the stand-alone tools' (workflows/cli/main.cpp): 2 a bad input,
+        // 1 a computation that failed; collect_stage turns them into the record's kind.
+        log::error("{}", e.what());
+        child_exit(fds[1], kExitInput, e.what());
       } catch (const std::exception& e) {
         log::error("{}", e.what());
-        child_exit(fds[1], 1, e.what());
+        child_exit(fds[1], kExitCompute, e.what());
       } catch (...) {
-        child_exit(fds[1], 1, "unknown error");
+        child_exit(fds[1], kExitCompute, "unknown error");
       }
     });
   } catch (const ComputeError& e) {
@@ -79,11 +84,14 @@ StageOutcome collect_stage(const StageChild& child, int wait_status, double peak
   while ((n = ::read(child.message_fd, buf, sizeof buf)) > 0) o.message.append(buf, static_cast<std::size_t>(n));
   ::close(child.message_fd);
   if (WIFEXITED(wait_status)) {
-    o.ok = WEXITSTATUS(wait_status) == 0;
-    if (!o.ok && o.message.empty()) o.message = fmt::format("exited with status {}", WEXITSTATUS(wait_status));
+    const int code = WEXITSTATUS(wait_status);
+    o.ok = code == 0;
+    if (!o.ok) o.error_kind = code == kExitInput ? ErrorKind::input : ErrorKind::compute;
+    if (!o.ok && o.message.empty()) o.message = fmt::format("exited with status {}", code);
   } else if (WIFSIGNALED(wait_status)) {
     const int sig = WTERMSIG(wait_status);
     o.interrupted = sig == SIGINT || sig == SIGTERM;
+    o.error_kind = o.interrupted ? ErrorKind::interrupted : ErrorKind::crash;
     o.message = fmt::format("killed by signal {} ({})", sig, ::strsignal(sig));
   }
   return o;

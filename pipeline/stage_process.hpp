@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "pipeline/manifest.hpp"
 #include "pipeline/stage.hpp"
 
 namespace stentsim::pipeline {
@@ -16,9 +17,14 @@ struct StageChild {
   int message_fd = -1;  // read end of the pipe carrying a failure message
 };
 
+/// A stage child's exit codes, as the stand-alone tools' (0 is success).
+inline constexpr int kExitCompute = 1;
+inline constexpr int kExitInput = 2;
+
 struct StageOutcome {
   bool ok = false;
   bool interrupted = false;  // ended by SIGINT/SIGTERM
+  ErrorKind error_kind = ErrorKind::none;
   std::string message;       // failure message
   double duration_s = 0;
   double peak_memory_mb = 0;

@@ -434,6 +434,7 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
     SolveRun run = prepare_solve_run(scene, ctx.resume_dir(), cfg.output.checkpoint_every);
     int status = 0;
     std::string mpi_end;
+    int mpi_exit = 0;
     if (!mpi) {
       solver::SolveOptions o;
       o.output_dir = run.dir;
@@ -461,7 +462,7 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
       const auto start = std::chrono::steady_clock::now();
       const pid_t pid = process::spawn_exec(argv);
       const process::ChildEnd end = process::wait_with_limit(pid, start, 1e9);
-      if (!end.ok()) status = 1, mpi_end = end.describe();
+      if (!end.ok()) status = 1, mpi_end = end.describe(), mpi_exit = end.exit_code;
       else ctx.summary() = Summary::read(run.dir / "summary.yaml");
       if (!face_warning.empty()) ctx.summary().note("warning_contact_face_size", face_warning);
     }
@@ -473,6 +474,10 @@ pipeline::Stage solve_stage(const CaseConfig& c) {
                                                  "bodies, conditions, contact or loads change",
                                                  (run.dir / "checkpoint.bin").string())
                                    : std::string();
+    if (mpi && mpi_exit == 2)  // `stentsim solve` exits 2 on a bad input (cli/main.cpp); its log says which
+      throw InputError(fmt::format("the MPI solve ({} ranks) refused its input (exit status 2; the log names the file and "
+                                   "field): {}",
+                                   cfg.simulation.ranks, (ctx.work_dir() / "logs" / "solve.log").string()));
     if (mpi)
       throw ComputeError(fmt::format("the MPI solve ({} ranks) ended with {} (the log says where and why); what it wrote "
                                      "is kept in {}{}",

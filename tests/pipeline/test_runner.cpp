@@ -153,6 +153,10 @@ TEST_F(RunnerTest, FailingStageLeavesEarlierOutputsAndReportsIt) {
   EXPECT_EQ(rep.exit_code(), 1);
   EXPECT_EQ(rep.failed, (std::vector<std::string>{"b"}));
   EXPECT_NE(rep.first_failure.find("deliberate failure of b"), std::string::npos);
+  // An InputError is a bad input: said on the progress line and recorded as such.
+  EXPECT_EQ(rep.first_failure_kind, ErrorKind::input);
+  EXPECT_NE(last_output.find("FAIL  b             bad input: deliberate failure of b"), std::string::npos) << last_output;
+  EXPECT_EQ(Manifest::load(work / "manifest.yaml").find("b")->error_kind, ErrorKind::input);
   EXPECT_EQ(files::read_text(work / "b/out.txt"), before);  // untouched
   EXPECT_EQ(count("c"), 1);                                  // downstream not run
   EXPECT_FALSE(fs::exists(work / ".tmp" / "b"));
@@ -196,6 +200,9 @@ TEST_F(RunnerTest, FailedStageKeepsItsPartialOutputsForTheUser) {
   config["b"] = "q=2 halfway";
   auto rep = run();
   EXPECT_EQ(rep.failed, (std::vector<std::string>{"b"}));
+  EXPECT_EQ(rep.first_failure_kind, ErrorKind::compute);  // a ComputeError
+  EXPECT_EQ(Manifest::load(work / "manifest.yaml").find("b")->error_kind, ErrorKind::compute);
+  EXPECT_EQ(last_output.find("bad input"), std::string::npos) << last_output;
   EXPECT_EQ(files::read_text(work / "b/out.txt"), before);  // the earlier artifact is untouched
   EXPECT_EQ(files::read_text(work / "failed" / "b" / "b" / "out.txt"), "last converged\n");
   EXPECT_NE(last_output.find("partial outputs: " + (work / "failed" / "b").string()), std::string::npos) << last_output;
@@ -217,6 +224,30 @@ TEST_F(RunnerTest, CrashingStageDoesNotTakeTheRunnerDown) {
   auto rep = run();
   EXPECT_EQ(rep.exit_code(), 1);
   EXPECT_NE(rep.first_failure.find("signal"), std::string::npos) << rep.first_failure;
+  EXPECT_EQ(rep.first_failure_kind, ErrorKind::crash);
+  EXPECT_EQ(Manifest::load(work / "manifest.yaml").find("d")->error_kind, ErrorKind::crash);
+}
+
+TEST(ManifestErrorKind, RoundTripsAndReadsAnOlderRecordAsUnknown) {
+  const fs::path dir = fs::temp_directory_path() / ("stentsim-manifest-kind-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Manifest m;
+  StageRecord r;
+  r.status = "failed";
+  r.error_kind = ErrorKind::input;
+  m.set("mesh", r);
+  r.status = "ok";
+  r.error_kind = ErrorKind::none;
+  m.set("centerline", r);
+  m.save(dir / "manifest.yaml");
+  const Manifest back = Manifest::load(dir / "manifest.yaml");
+  EXPECT_EQ(back.find("mesh")->error_kind, ErrorKind::input);
+  EXPECT_EQ(back.find("centerline")->error_kind, ErrorKind::none);
+  files::write_atomic(dir / "old.yaml", "tool_version: x\nstages:\n  mesh: {status: failed, message: boom}\n");
+  EXPECT_EQ(Manifest::load(dir / "old.yaml").find("mesh")->error_kind, ErrorKind::unknown);
+  for (ErrorKind k : {ErrorKind::input, ErrorKind::compute, ErrorKind::crash, ErrorKind::interrupted})
+    EXPECT_EQ(error_kind_from(to_string(k)), k);
+  fs::remove_all(dir);
 }
 
 TEST_F(RunnerTest, InterruptedRunResumes) {

@@ -106,7 +106,7 @@ TEST_F(Cohort, RunsEveryCaseThenSkipsWhatIsUpToDate) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << r.out;
   const auto csv = read_text(dir / "cohort.work/cohort_summary.csv");
-  EXPECT_NE(csv.find("\"case\",\"status\",\"exit_code\",\"failed_stage\",\"message\""), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"case\",\"status\",\"exit_code\",\"failed_stage\",\"error_kind\",\"message\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("\"coarse\",\"done\",\"0\""), std::string::npos) << csv;
   EXPECT_NE(csv.find("mesh.artery_elements"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\"256\""), std::string::npos) << csv;  // 16 x 4 x 4 hex8 for `coarse`
@@ -422,8 +422,14 @@ TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   // the expected failure shows as such in `cohort status`.
   EXPECT_EQ(read_csv(dir / "cohort.work/cohort_summary.csv").size(), 6u) << csv;
   // The message is the stage's error, not the log's last lines with their prefixes.
-  const std::string message = read_csv(dir / "cohort.work/cohort_summary.csv")["severe"]["message"];
+  auto rows = read_csv(dir / "cohort.work/cohort_summary.csv");
+  const std::string message = rows["severe"]["message"];
   EXPECT_EQ(message.rfind("stage placement: ", 0), 0u) << message;
+  // A device that does not fit the vessel is a bad input (the case's device or site), and
+  // the summary says so; the manifest records the same kind.
+  EXPECT_EQ(rows["severe"]["error_kind"], "input") << csv;
+  EXPECT_EQ(rows["rca-seed1"]["error_kind"], "") << csv;
+  EXPECT_NE(read_text(dir / "cohort.work/severe/work/manifest.yaml").find("error_kind: input"), std::string::npos);
   r = sh("cohort status " + f);
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(status_cells(r.out, "severe")["placement"], "failed (expected)") << r.out;
@@ -436,6 +442,7 @@ TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   EXPECT_TRUE(fs::exists(dir / "cohort.work/plot_placement.placement_min_clearance.png"));
   const auto md = read_text(dir / "cohort.work/cohort_summary.md");
   EXPECT_NE(md.find("| severe | failed as expected | placement |"), std::string::npos) << md;
+  EXPECT_NE(md.find("(failed as expected at placement, bad input)"), std::string::npos) << md;
   EXPECT_NE(md.find("[plot_centerline.stenosis_percent_diameter.png]"), std::string::npos) << md;
   fs::remove_all(dir);
 }

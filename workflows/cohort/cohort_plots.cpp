@@ -17,11 +17,10 @@ namespace fs = std::filesystem;
 namespace stentsim::workflows {
 namespace {
 
-const std::vector<std::string> kFixedColumns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s", "inputs"};
-
 // Fixed and input columns are not QoIs: no plot, no statistics.
 bool is_fixed(const std::string& col) {
-  return std::find(kFixedColumns.begin(), kFixedColumns.end(), col) != kFixedColumns.end() || col.rfind("override.", 0) == 0;
+  const auto& fixed = cohort_fixed_columns();
+  return std::find(fixed.begin(), fixed.end(), col) != fixed.end() || col.rfind("override.", 0) == 0;
 }
 
 std::optional<double> number(const std::string& s) {
@@ -193,8 +192,10 @@ void write_cohort_markdown(const CohortConfig& c, const CohortTable& t) {
     if (!cell(row, "message").empty()) {
       if (!any_failure) md += "\n## Failures (last log lines)\n\n";
       any_failure = true;
-      md += fmt::format("- **{}** ({}{}): {}\n", markdown_cell(cell(row, "case")), cell(row, "status"),
+      const std::string kind = cell(row, "error_kind");
+      md += fmt::format("- **{}** ({}{}{}): {}\n", markdown_cell(cell(row, "case")), cell(row, "status"),
                         cell(row, "failed_stage").empty() ? "" : " at " + cell(row, "failed_stage"),
+                        kind.empty() ? "" : kind == "input" ? ", bad input" : ", " + markdown_cell(kind),
                         markdown_cell(cell(row, "message")));
     }
   files::write_atomic(c.work_dir / "cohort_summary.md", md);

@@ -100,12 +100,26 @@ std::string failure_message(const fs::path& log) {
   return error.empty() ? tail_lines(log, 3) : error;
 }
 
-std::string failed_stage_of(const fs::path& manifest_file) {
-  if (!fs::exists(manifest_file)) return "";
+// The first failed stage in the case's manifest, or none.
+std::optional<pipeline::StageRecord> failed_record(const fs::path& manifest_file, std::string& stage) {
+  stage.clear();
+  if (!fs::exists(manifest_file)) return std::nullopt;
   const auto m = pipeline::Manifest::load(manifest_file);
   for (const auto& name : all_stage_names())
-    if (auto* r = m.find(name); r && r->status != "ok") return name;
-  return "";
+    if (auto* r = m.find(name); r && r->status != "ok") {
+      stage = name;
+      return *r;
+    }
+  return std::nullopt;
+}
+
+// The error kind of a case's `stentsim run` from its exit status and the failed stage's record.
+std::string error_kind_of(int exit_code, const std::optional<pipeline::StageRecord>& failed) {
+  if (exit_code == 0) return "";
+  if (exit_code == 130) return "interrupted";
+  if (exit_code > 128) return "crash";  // the worker itself was killed
+  if (failed) return pipeline::to_string(failed->error_kind);
+  return exit_code == 2 ? "input" : "compute";  // refused before any stage ran: the case file, the work folder
 }
 
 bool stage_succeeded(const fs::path& manifest_file, const std::string& stage) {
@@ -207,7 +221,8 @@ CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_co
   r.id = k.id;
   r.wall_s = wall_s;
   r.exit_code = exit_code;
-  r.failed_stage = r.exit_code ? failed_stage_of(dir / "work" / "manifest.yaml") : "";
+  const auto failed = r.exit_code ? failed_record(dir / "work" / "manifest.yaml", r.failed_stage) : std::nullopt;
+  r.error_kind = error_kind_of(r.exit_code, failed);
   if (r.exit_code == 0)
     // With --until/--only the stage meant to fail may not have run: then "done".
     r.status = k.expect_failure && stage_succeeded(dir / "work" / "manifest.yaml", *k.expect_failure) ? "succeeded unexpectedly" : "done";
@@ -393,6 +408,12 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
   return rep;
 }
 
+const std::vector<std::string>& cohort_fixed_columns() {
+  static const std::vector<std::string> columns = {"case", "status", "exit_code", "failed_stage", "error_kind",
+                                                   "message", "wall_time_s", "inputs"};
+  return columns;
+}
+
 CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
   // Columns: fixed ones, then "<stage>.<qoi>" for every QoI any case has.
   CohortTable t;
@@ -403,6 +424,7 @@ CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
                                               {"status", o.status},
                                               {"exit_code", o.exit_code >= 0 ? std::to_string(o.exit_code) : std::string()},
                                               {"failed_stage", o.failed_stage},
+                                              {"error_kind", o.error_kind},
                                               {"message", o.message},
                                               {"wall_time_s", fmt::format("{:.3f}", o.wall_s)}};
     if (k != c.cases.end()) {
@@ -436,7 +458,7 @@ CohortTable cohort_table(const CohortConfig& c, const CohortReport& r) {
     }
     t.rows.push_back(std::move(row));
   }
-  t.columns = {"case", "status", "exit_code", "failed_stage", "message", "wall_time_s", "inputs"};
+  t.columns = cohort_fixed_columns();
   t.columns.insert(t.columns.end(), override_columns.begin(), override_columns.end());
   t.columns.insert(t.columns.end(), columns.begin(), columns.end());
   return t;
@@ -491,6 +513,7 @@ void add_unselected_cases(const CohortConfig& c, CohortReport& r) {
       o.status = row["status"];
       o.exit_code = row["exit_code"].empty() ? -1 : std::atoi(row["exit_code"].c_str());
       o.failed_stage = row["failed_stage"];
+      o.error_kind = row["error_kind"];
       o.message = row["message"];
       o.wall_s = std::atof(row["wall_time_s"].c_str());
     } else {
@@ -499,7 +522,8 @@ void add_unselected_cases(const CohortConfig& c, CohortReport& r) {
         o.status = "not run";
         o.exit_code = -1;
       } else {
-        o.failed_stage = failed_stage_of(manifest);
+        const auto failed = failed_record(manifest, o.failed_stage);
+        if (failed) o.error_kind = pipeline::to_string(failed->error_kind);
         if (o.failed_stage.empty()) o.status = "done";
         else {
           o.status = k.expect_failure && *k.expect_failure == o.failed_stage ? "failed as expected" : "failed";

@@ -28,6 +28,10 @@ struct CaseOutcome {
   std::string id;
   std::string status;        // done | failed | failed as expected | succeeded unexpectedly | interrupted
   std::string failed_stage;  // from the case's manifest
+  /// Why it failed (empty when it did not): the failed stage's kind from the manifest
+  /// (input: a bad input file or setting, compute, crash, unknown), input for a case file
+  /// `stentsim run` refused (exit 2), crash for a killed worker, interrupted, lost (Slurm).
+  std::string error_kind;
   std::string message;       // last lines of the case's log on failure
   int exit_code = 0;         // the case's `stentsim run`: its exit status, 128 + signal when killed, -1 unknown (lost)
   double wall_s = 0;
@@ -96,7 +100,7 @@ std::map<std::string, double> stages_finished_since(const std::filesystem::path&
 CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::ostream& out);
 
 /// The cohort summary as a table: fixed columns (case, status, exit_code,
-/// failed_stage, message, wall_time_s, inputs: the merged case's `input`
+/// failed_stage, error_kind, message, wall_time_s, inputs: the merged case's `input`
 /// section as "key=value; ..." with files by name), then "override.<dotted
 /// key>" for every key any case overrides (files by name, a removed key
 /// "null"), then "<stage>.<qoi> [unit]" for every QoI any case's stage
@@ -106,6 +110,8 @@ struct CohortTable {
   std::vector<std::map<std::string, std::string>> rows;  // column -> cell
 };
 CohortTable cohort_table(const CohortConfig& c, const CohortReport& r);
+/// The table's fixed columns, in order (no statistics, no plots).
+const std::vector<std::string>& cohort_fixed_columns();
 
 /// Adds the cases a run with --cases left out, so that the cohort summary
 /// keeps one row per case of the cohort: each from its row of the previous

@@ -225,6 +225,7 @@ CaseOutcome lost_outcome(const CohortCase& k, const TaskRecord& t, const std::st
   r.wall_s = wall;
   r.exit_code = -1;  // unknown: the task never wrote its exit code
   r.status = "failed";
+  r.error_kind = "lost";
   r.message = fmt::format("lost: time, memory or node (Slurm task {} {}); Slurm output: {}", t.job, state,
                           tail_of(t.output, 3));
   return r;
