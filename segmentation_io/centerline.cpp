@@ -170,7 +170,9 @@ CenterlineResult compute_centerline(const MeshData& lumen, const CenterlineOptio
 
 CenterlineResult compute_centerline(const TriSurface& s, const CenterlineOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (!(o.spacing > 0)) throw InputError("centerline: spacing must be positive");
+  if (!(o.spacing >= kMinCenterlineSpacing && o.spacing <= kMaxCenterlineSpacing))
+    throw InputError(fmt::format("centerline: spacing {:g} mm is outside {:g} to {:g} mm", o.spacing, kMinCenterlineSpacing,
+                                 kMaxCenterlineSpacing));
   CenterlineResult res;
 
   // Ends.

@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 #include "common/config.hpp"
@@ -27,8 +28,14 @@
 
 namespace stentsim::segmentation {
 
+/// Bounds of the resampling spacing (mm): below the lower one a long vessel's
+/// centerline holds millions of points (memory and time for nothing); above the
+/// upper one a coronary's lesion falls between two points.
+inline constexpr double kMinCenterlineSpacing = 0.01;
+inline constexpr double kMaxCenterlineSpacing = 2.0;
+
 struct CenterlineOptions {
-  double spacing = 0.1;  // mm between output points
+  double spacing = 0.1;  // mm between output points, within the bounds above
   /// When both are given, the centerline runs between the interior Voronoi
   /// nodes nearest to them (needed for closed surfaces and trees); otherwise
   /// between the centroids of the two open ends.
@@ -107,7 +114,10 @@ void run_centerline_stage(const CenterlineOptions& options, const std::filesyste
                           const std::filesystem::path& out_centerline_vtp, Summary& summary);
 /// The same on a lumen already read (`source` names it in errors): the stand-alone
 /// tool passes a user's file through the case path's reader and surface checks first.
+/// `before_write` sees the result before anything is written (the stand-alone tool's
+/// units rule); it throws to refuse it.
 void run_centerline_stage(const CenterlineOptions& options, const MeshData& lumen, const std::string& source,
-                          const std::filesystem::path& out_centerline_vtp, Summary& summary);
+                          const std::filesystem::path& out_centerline_vtp, Summary& summary,
+                          const std::function<void(const CenterlineResult&)>& before_write = {});
 
 }  // namespace stentsim::segmentation

@@ -9,7 +9,7 @@ namespace stentsim::segmentation {
 
 CenterlineOptions parse_centerline_options(ConfigMap& section) {
   CenterlineOptions o;
-  o.spacing = section.quantity("spacing", units::kLength, 0.1, Range::positive());
+  o.spacing = section.quantity("spacing", units::kLength, 0.1, Range::between(kMinCenterlineSpacing, kMaxCenterlineSpacing));
   bool has_s = section.has("source"), has_t = section.has("target");
   if (has_s != has_t)
     section.fail(has_s ? "source" : "target", "give both source and target points (mm), or neither to use the open ends");
@@ -34,13 +34,15 @@ void run_centerline_stage(const CenterlineOptions& options, const std::filesyste
 }
 
 void run_centerline_stage(const CenterlineOptions& options, const MeshData& lumen, const std::string& source,
-                          const std::filesystem::path& out_centerline_vtp, Summary& summary) {
+                          const std::filesystem::path& out_centerline_vtp, Summary& summary,
+                          const std::function<void(const CenterlineResult&)>& before_write) {
   CenterlineResult r;
   try {
     r = compute_centerline(lumen, options);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", source, e.what()));
   }
+  if (before_write) before_write(r);
   write_vtp(out_centerline_vtp.string(), r.centerline);
   summary.set("centerline_length", r.length, "mm");
   summary.set("centerline_points", double(r.centerline.points.size()));

@@ -49,6 +49,7 @@ SurfaceInput parse_surface_input(ConfigMap& section) {
   in.lumen = section.path("lumen");
   if (section.has("wall")) in.wall = section.path("wall");
   in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
+  in.checks.units_key = section.key_path("units");
   in.checks.repair = section.boolean("repair", true);
   in.checks.expected_open_ends = section.integer("open_ends", 2, Range::between(0, 2));
   in.synthesis = parse_wall_synthesis(section);
@@ -65,6 +66,7 @@ SimVascularInput parse_simvascular_input(ConfigMap& section) {
   if (section.has("wall")) in.wall = section.path("wall");
   in.points_per_contour = section.integer("points_per_contour", 64, Range::between(8, 1024));
   in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
+  in.checks.units_key = section.key_path("units");
   in.checks.repair = section.boolean("repair", true);
   in.synthesis = parse_wall_synthesis(section);
   section.finish();
@@ -86,6 +88,7 @@ LabelImageInput parse_label_image_input(ConfigMap& section) {
   in.end_trim = section.quantity("end_trim", units::kLength, 0.0, Range::non_negative());
   in.units_given = section.has("units");
   in.checks.units = section.choice("units", {"mm", "cm", "m", "um"}, std::string("mm"));
+  in.checks.units_key = section.key_path("units");
   in.checks.repair = section.boolean("repair", true);
   in.synthesis = parse_wall_synthesis(section);
   section.finish();

@@ -19,6 +19,13 @@ using Eigen::Vector3d;
 
 namespace {
 
+// A setting as the user writes it: a case key "input.surface.units: cm", a command-line
+// option "--units cm".
+std::string units_setting(const std::string& key, const std::string& value) {
+  return key.rfind("--", 0) == 0 ? key + " " + value : key + ": " + value;
+}
+
+
 std::string at(const Vector3d& p) { return fmt::format("({:.3f}, {:.3f}, {:.3f}) mm", p.x(), p.y(), p.z()); }
 
 Vector3d triangle_centroid(const TriSurface& s, const std::array<int, 3>& t) {
@@ -88,7 +95,7 @@ TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& o, const st
   const double diag = bounding_box_diagonal(s);
   if (diag < o.min_size || diag > o.max_size) {
     const std::string u = likely_units(diag, o.units, o.min_size, o.max_size);
-    const std::string hint = u.empty() ? "" : fmt::format("; the file looks like it is in {}: set units: {}", unit_word(u), u);
+    const std::string hint = u.empty() ? "" : fmt::format("; the file looks like it is in {}: set {}", unit_word(u), units_setting(o.units_key, u));
     fail(fmt::format("the surface spans {:.4g} mm (bounding-box diagonal) with units '{}', but a coronary segment spans "
                      "{:g} to {:g} mm{}", diag, o.units, o.min_size, o.max_size, hint));
   }
@@ -307,10 +314,10 @@ void check_reference_diameter_units(double d, const std::string& declared, const
   if (d >= kMinReferenceDiameter && d <= kMaxReferenceDiameter) return;
   const std::string u = likely_units(d, declared, kMinReferenceDiameter, kMaxReferenceDiameter);
   throw InputError(fmt::format(
-      "{}: the lumen's reference diameter is {:.4g} mm with {}: {}, but a coronary lumen's is about {:g} to {:g} mm{}",
-      what, d, units_key, declared, kMinReferenceDiameter, kMaxReferenceDiameter,
+      "{}: the lumen's reference diameter is {:.4g} mm with {}, but a coronary lumen's is about {:g} to {:g} mm{}",
+      what, d, units_setting(units_key, declared), kMinReferenceDiameter, kMaxReferenceDiameter,
       u.empty() ? fmt::format("; check the file's units ({}) or the region of interest", units_key)
-                : fmt::format("; the file looks like it is in {}: set {}: {}", unit_word(u), units_key, u)));
+                : fmt::format("; the file looks like it is in {}: set {}", unit_word(u), units_setting(units_key, u))));
 }
 
 }  // namespace stentsim::segmentation

@@ -39,6 +39,7 @@ void check_reference_diameter_units(double reference_diameter_mm, const std::str
 
 struct SurfaceCheckOptions {
   std::string units = "mm";           // units of the file's coordinates
+  std::string units_key = "units";    // the setting that gives them, for errors ("input.surface.units", "--units")
   bool repair = true;                  // false: every defect is an error
   int expected_open_ends = 2;          // open tube ends (proximal and distal cuts); 0 for a closed surface
   double merge_tolerance = 1e-6;       // duplicate points closer than this × bounding-box diagonal are merged

@@ -98,6 +98,11 @@ TEST(CaseConfig, BadFilesGiveErrorsThatNameFileLineKeyAndExpectation) {
   msg = load_error("scene: generic-artery\nmesh:\n  generic: {elements_around: 4096, elements_along: 100000}\n");
   EXPECT_NE(msg.find("mesh.generic.elements_along"), std::string::npos) << msg;
   EXPECT_NE(msg.find("1.64e+09 hex8, more than mesh.max_elements = 1e+06"), std::string::npos) << msg;
+  // A resampling spacing that would put millions of points on the centerline, or skip a lesion.
+  for (const char* spacing : {"1e-6 mm", "1 m"}) {
+    msg = load_error("scene: patient\n" + in + "centerline:\n  spacing: " + spacing + "\n");
+    EXPECT_NE(msg.find("bad.yaml:4:12: centerline.spacing"), std::string::npos) << msg;
+  }
   msg = load_error("scene: patient\nmesh:\n  max_elements: 0\n");
   EXPECT_NE(msg.find("mesh.max_elements"), std::string::npos) << msg;
 }

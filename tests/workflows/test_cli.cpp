@@ -186,6 +186,28 @@ TEST_F(Cli, StandAloneCenterlineChecksItsSurfaceAsTheCasePathDoes) {
   EXPECT_EQ(r.code, 2) << r.out;
 }
 
+// The units rule and the spacing bounds hold for the stand-alone tool as for a case: a
+// phantom in mm declared in cm or um is refused with the units it looks like, and nothing
+// is written.
+TEST_F(Cli, StandAloneCenterlineRefusesMisdeclaredUnitsAndSpacing) {
+  const std::string d = dir.string();
+  auto r = sh("phantom --preset case2-rca --out " + d + "/ph");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* units : {"cm", "um"}) {
+    r = sh("centerline --lumen " + d + "/ph/lumen.vtp --units " + units + " --out " + d + "/u/centerline.vtp");
+    EXPECT_EQ(r.code, 2) << units << ": " << r.out;
+    EXPECT_NE(r.out.find("lumen.vtp"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("set --units mm"), std::string::npos) << units << ": " << r.out;
+    EXPECT_FALSE(fs::exists(dir / "u/centerline.vtp"));
+  }
+  for (const char* spacing : {"1e-9", "0", "50"}) {
+    r = sh("centerline --lumen " + d + "/ph/lumen.vtp --spacing " + spacing + " --out " + d + "/s/centerline.vtp");
+    EXPECT_EQ(r.code, 2) << spacing << ": " << r.out;
+    EXPECT_NE(r.out.find("--spacing"), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "s/centerline.vtp"));
+}
+
 TEST_F(Cli, SolveRunsASceneAndRejectsBadOnes) {
   const std::string scene = std::string(STENTSIM_TEST_SOURCE_DIR) + "/examples/tube_inflation.yaml";
   auto r = sh("solve " + scene + " --out " + dir.string());

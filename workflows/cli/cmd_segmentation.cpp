@@ -63,7 +63,8 @@ void register_segmentation(CLI::App& app) {
   cl->add_option("--lumen", c->lumen, "Lumen surface (.vtp, .vtk, .stl or .obj; two open ends)")->required();
   cl->add_option("--units", c->units, "Units of the lumen file's coordinates")->check(CLI::IsMember({"mm", "cm", "m", "um"}));
   cl->add_option("--out", c->out, "Output centerline.vtp")->required();
-  cl->add_option("--spacing", c->spacing, "Resampling spacing in mm")->check(CLI::PositiveNumber);
+  cl->add_option("--spacing", c->spacing, "Resampling spacing in mm")
+      ->check(CLI::Range(segmentation::kMinCenterlineSpacing, segmentation::kMaxCenterlineSpacing));
   cl->add_option("--true-centerline", c->truth, "A phantom's centerline_true.vtp to report accuracy against");
   on(cl, [c] {
     segmentation::CenterlineOptions o;
@@ -74,10 +75,18 @@ void register_segmentation(CLI::App& app) {
     // file is an error here too, not a centerline of garbage.
     segmentation::SurfaceCheckOptions checks;
     checks.units = c->units;
+    checks.units_key = "--units";
     segmentation::SurfaceReport report;
     const segmentation::TriSurface lumen = segmentation::load_checked_surface(c->lumen, checks, report);
     segmentation::report_to_summary("lumen", report, summary);
-    segmentation::run_centerline_stage(o, segmentation::mesh_from_surface(lumen), c->lumen, c->out, summary);
+    // The case path's units rule too: a lumen whose healthy diameter is no coronary's in
+    // the declared units (a file in cm read as mm) is refused before anything is written.
+    segmentation::run_centerline_stage(o, segmentation::mesh_from_surface(lumen), c->lumen, c->out, summary,
+                                       [&](const segmentation::CenterlineResult& r) {
+                                         segmentation::check_reference_diameter_units(
+                                             segmentation::robust_reference_diameter(r.stenoses), c->units, c->lumen,
+                                             "--units");
+                                       });
     summary.write(std::filesystem::path(c->out).parent_path() / "summary.yaml");
     return 0;
   });
