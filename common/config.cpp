@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 
 namespace stentsim {
 namespace {
@@ -81,9 +82,7 @@ std::string printable(const std::string& text) {
 }  // namespace
 
 ConfigMap ConfigMap::load(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: file not found", file.string()));
-  if (!std::filesystem::is_regular_file(file))
-    throw InputError(fmt::format("{}: not a regular file (a folder?); give the YAML file itself", file.string()));
+  files::require_regular_file(file, "YAML file");
   YAML::Node root;
   try {
     root = YAML::LoadFile(file.string());

@@ -71,7 +71,16 @@ void replace(const fs::path& from, const fs::path& to) {
   if (ec) throw ComputeError(fmt::format("cannot rename {} to {}: {}", from.string(), to.string(), ec.message()));
 }
 
+void require_regular_file(const fs::path& file, const std::string& what) {
+  std::error_code ec;
+  const auto st = fs::status(file, ec);
+  if (!fs::exists(st)) throw InputError(fmt::format("{}: file not found", file.string()));
+  if (!fs::is_regular_file(st))
+    throw InputError(fmt::format("{}: not a regular file (a folder, device or pipe); give the {} itself", file.string(), what));
+}
+
 std::string read_text(const fs::path& file) {
+  require_regular_file(file);
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot be read", file.string()));
   std::ostringstream ss;

@@ -16,7 +16,14 @@ std::filesystem::path temporary_name_for(const std::filesystem::path& target);
 /// Renames `from` onto `to`, replacing it (files or folders).
 void replace(const std::filesystem::path& from, const std::filesystem::path& to);
 
-/// Reads a whole file; throws InputError naming it when it cannot be read.
+/// InputError unless `file` is a regular file (resolving symbolic links): "<file>:
+/// file not found", or "not a regular file (a folder, device or pipe)" — a FIFO or a
+/// device would block a reader or feed it without end. `what` names the file in the
+/// remedy ("give the <what> itself").
+void require_regular_file(const std::filesystem::path& file, const std::string& what = "file");
+
+/// Reads a whole regular file (require_regular_file); throws InputError naming it
+/// when it cannot be read.
 std::string read_text(const std::filesystem::path& file);
 
 /// 128-bit xxHash (XXH3) of a file's content as 32 hex digits. For a folder,

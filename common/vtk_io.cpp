@@ -110,11 +110,7 @@ void write_with(const std::string& file, Data* data) {
   files::replace(tmp, target);
 }
 
-void require_readable(const std::string& file) {
-  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: file not found", file));
-  if (!std::filesystem::is_regular_file(file))
-    throw InputError(fmt::format("{}: not a regular file (a folder, device or pipe); give the file itself", file));
-}
+
 
 // VTK's XML reader allocates what a piece's NumberOfPoints / NumberOfPolys ... say
 // before reading a byte of it: a damaged count means gigabytes (std::bad_alloc). Even
@@ -225,7 +221,7 @@ void write_vtp(const std::string& file, const MeshData& m) {
 }
 
 void check_vtk_xml_file(const std::string& file) {
-  require_readable(file);
+  files::require_regular_file(file);
   check_xml_counts(file);
   const std::string ext = std::filesystem::path(file).extension().string();
   process::probe_read_in_child(file, "VTK XML", [&] {

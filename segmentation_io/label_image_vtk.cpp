@@ -26,6 +26,7 @@
 #include <cmath>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "segmentation_io/branch_extraction.hpp"
 #include "segmentation_io/image_header_checks.hpp"
 #include "segmentation_io/image_header_geometry.hpp"
@@ -61,7 +62,7 @@ bool ends_with(const std::string& s, const std::string& e) {
 
 TriSurface label_image_surface(const std::filesystem::path& file, const LabelSurfaceOptions& o) {
   const std::string name = file.string();
-  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: label image not found", name));
+  files::require_regular_file(file, "label image");
   std::string lower = name;
   std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   vtkSmartPointer<vtkImageData> image;

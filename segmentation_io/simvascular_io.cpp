@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 
 namespace stentsim::segmentation {
 
@@ -28,7 +29,7 @@ struct XmlFile {
 
 void load_xml(XmlFile& x, const std::filesystem::path& file) {
   x.name = file.string();
-  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: file not found", x.name));
+  files::require_regular_file(file, "SimVascular file");
   pugi::xml_parse_result r = x.doc.load_file(file.c_str());
   if (!r)
     throw InputError(fmt::format("{}: not valid XML ({} at byte {})", x.name, r.description(), r.offset));

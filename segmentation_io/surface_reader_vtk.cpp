@@ -20,6 +20,7 @@
 #include <optional>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "segmentation_io/legacy_vtk_ascii.hpp"
 #include "segmentation_io/stl_binary.hpp"
 #include "segmentation_io/surface_input.hpp"
@@ -64,9 +65,7 @@ void check_point_indices(vtkPolyData* pd, const std::filesystem::path& file) {
 }  // namespace
 
 TriSurface read_surface_file(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{}: surface file not found", file.string()));
-  if (!std::filesystem::is_regular_file(file))
-    throw InputError(fmt::format("{}: not a regular file (a folder, device or pipe); give the surface file itself", file.string()));
+  files::require_regular_file(file, "surface file");
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   vtkSmartPointer<vtkAlgorithm> reader;

@@ -85,11 +85,8 @@ void HistoryArchive::write(const std::filesystem::path& file) const {
 }
 
 HistoryArchive HistoryArchive::read(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(fmt::format("{}: cannot open the checkpoint", file.string()));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string data = ss.str();
+  files::require_regular_file(file, "checkpoint");
+  std::string data = files::read_text(file);
   Reader r{data, 0, file.string()};
   if (r.bytes(sizeof(kMagic) - 1) != kMagic) throw InputError(fmt::format("{}: not a stentsim checkpoint", file.string()));
   const auto version = r.raw<std::uint32_t>();

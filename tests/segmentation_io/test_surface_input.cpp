@@ -18,10 +18,16 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <functional>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <fstream>
 #include <limits>
 
 #include "common/error.hpp"
+#include "common/files.hpp"
+#include "segmentation_io/label_image.hpp"
+#include "segmentation_io/simvascular_io.hpp"
 #include "segmentation_io/centerline.hpp"
 #include "segmentation_io/phantom.hpp"
 #include "segmentation_io/segmentation_stage.hpp"
@@ -206,6 +212,37 @@ TEST(SurfaceReaders, OutOfRangeIndicesAndFoldersAreErrors) {
   }
   fs::create_directories(d / "folder.stl");
   EXPECT_CONTAINS(error_of([&] { read_surface_file(d / "folder.stl"); }), "not a regular file");
+  fs::remove_all(d);
+}
+
+// A FIFO or a device given as an input (directly or through a symbolic link) would block
+// a reader or feed it without end: every reader a user can feed refuses it at once.
+TEST(SurfaceReaders, FifosAndDevicesAreRefusedWithoutReading) {
+  const fs::path d = fs::temp_directory_path() / ("stentsim-fifo-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  ASSERT_EQ(::mkfifo((d / "pipe").c_str(), 0600), 0);
+  const std::vector<std::string> names = {"lumen.stl", "lumen.vtp", "label.nii.gz", "label.mha", "path.pth", "seg.ctgr"};
+  for (const std::string& target : {(d / "pipe").string(), std::string("/dev/zero")}) {
+    for (const auto& n : names) {
+      fs::remove(d / n);
+      fs::create_symlink(target, d / n);
+    }
+    const std::vector<std::pair<std::string, std::function<void()>>> readers = {
+        {"lumen.stl", [&] { read_surface_file(d / "lumen.stl"); }},
+        {"lumen.vtp", [&] { read_surface_file(d / "lumen.vtp"); }},
+        {"label.nii.gz", [&] { label_image_surface(d / "label.nii.gz", LabelSurfaceOptions{}); }},
+        {"label.mha", [&] { label_image_surface(d / "label.mha", LabelSurfaceOptions{}); }},
+        {"path.pth", [&] { read_simvascular_path(d / "path.pth"); }},
+        {"seg.ctgr", [&] { read_simvascular_contours(d / "seg.ctgr"); }},
+        {"lumen.stl", [&] { stentsim::files::read_text(d / "lumen.stl"); }},
+    };
+    for (const auto& [name, read] : readers) {
+      const std::string e = error_of(read);
+      EXPECT_CONTAINS(e, name);
+      EXPECT_CONTAINS(e, "not a regular file (a folder, device or pipe)");
+    }
+  }
   fs::remove_all(d);
 }
 

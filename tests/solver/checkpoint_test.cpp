@@ -3,6 +3,7 @@
 // before the predictor existed) read as "no guess for the first step".
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -34,6 +35,26 @@ TEST(SolverCheckpoint, RoundTripKeepsThePredictorState) {
   EXPECT_EQ(r.counters.predicted_steps, 7);
   EXPECT_EQ(r.counters.step_cuts, 2);
   EXPECT_THROW(SolverCheckpoint::get(a, 6), InputError);  // another model
+}
+
+// --restart with a FIFO or a device (a checkpoint name pointing at /dev/zero) is an input
+// error at once, not a read without end.
+TEST(SolverCheckpoint, AFifoOrADeviceIsNotReadAsACheckpoint) {
+  const std::filesystem::path d = std::filesystem::temp_directory_path() / ("stentsim-ckpt-fifo-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  ASSERT_EQ(::mkfifo((d / "pipe.bin").c_str(), 0600), 0);
+  std::filesystem::create_symlink("/dev/zero", d / "zero.bin");
+  for (const char* f : {"pipe.bin", "zero.bin"}) {
+    try {
+      HistoryArchive::read(d / f);
+      ADD_FAILURE() << f << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(d);
 }
 
 TEST(SolverCheckpoint, WithoutPredictorStateResumesWithoutAGuess) {
