@@ -24,6 +24,18 @@ Vec3 vec3(ConfigMap& m, const std::string& key, std::optional<Vec3> def = std::n
   return {v[0], v[1], v[2]};
 }
 
+// A generated mesh's element count before anything is allocated: refused above
+// kMaxGeneratedElements (of the requested kind: a hex8 splits into 6 tets), so a typo
+// of a few zeros is an error naming the key, never minutes of allocation or bad_alloc.
+constexpr double kMaxGeneratedElements = 5e6;
+void check_generated_count(ConfigMap& g, const std::string& key, const std::string& product, double hex8, const std::string& element) {
+  const double n = element == "hex8" ? hex8 : 6 * hex8;
+  if (n > kMaxGeneratedElements)
+    g.fail(key, fmt::format("{} gives {:.3g} {} elements, more than the {:.0e} a generated mesh may have; read a larger "
+                            "model from a .vtu (file:)",
+                            product, n, element, kMaxGeneratedElements));
+}
+
 MeshData read_mesh(ConfigMap& m, std::string& source) {
   const bool has_file = m.has("file"), has_gen = m.has("generate");
   if (has_file == has_gen) m.fail("", "give exactly one of 'file' (a .vtu) or 'generate'");
@@ -53,11 +65,18 @@ MeshData read_mesh(ConfigMap& m, std::string& source) {
     const int nz = g.integer("axial", 1, Range{1.0, 1e5});
     // 360 deg closes the ring: the seam's nodes are shared.
     if (angle == 360.0 && nt < 3) g.fail("circumferential", "a closed ring needs at least 3 elements around");
+    check_generated_count(g, "axial", "radial x circumferential x axial", double(nr) * nt * nz, element);
     mesh = ring_sector_hex8(ri, ro, angle * std::numbers::pi / 180.0, height, nr, nt, nz);
     source = fmt::format("generated ring sector {}x{}x{} {}", nr, nt, nz, element);
   } else {
     const auto size = g.numbers("size", 3);
     const auto cells = g.numbers("cells", 3);
+    for (double v : size)
+      if (!(v > 0 && std::isfinite(v))) g.fail("size", fmt::format("expected three positive lengths (mm), got {:g}", v));
+    for (double v : cells)
+      if (!(v >= 1 && v <= 1e5 && v == std::floor(v)))
+        g.fail("cells", fmt::format("expected three whole numbers of cells from 1 to 100000, got {:g}", v));
+    check_generated_count(g, "cells", "the product of cells", cells[0] * cells[1] * cells[2], element);
     mesh = box_hex8(static_cast<int>(cells[0]), static_cast<int>(cells[1]), static_cast<int>(cells[2]), size[0], size[1], size[2]);
     source = fmt::format("generated box {}x{}x{} {}", cells[0], cells[1], cells[2], element);
   }

@@ -148,6 +148,19 @@ TEST(SolverScene, BadInputNamesFileAndKey) {
   // Preconditioner lagging only for the Krylov types, with one of its two values.
   expect_error("type: direct", "type: direct, preconditioner_update: lagged", "preconditioner_update: applies to the Krylov types");
   expect_error("type: direct", "type: gmres_amg, preconditioner_update: sometimes", "preconditioner_update");
+  // Generated meshes: the element count is checked before anything is allocated (10^14
+  // hex8 here once overflowed an int), and a box's cells are whole positive numbers.
+  expect_error("radial: 8\n        circumferential: 24\n        axial: 1",
+               "radial: 10000\n        circumferential: 100000\n        axial: 100000",
+               "axial: radial x circumferential x axial gives 1e+14 hex8 elements, more than the 5e+06");
+  const std::string ring = "type: ring_sector          # quarter annulus about the z axis\n        inner_radius: 0.8 mm\n"
+                           "        outer_radius: 1.4 mm\n        angle_deg: 90\n        height: 0.05 mm            # one layer of "
+                           "elements: plane strain with u_z = 0\n        radial: 8\n        circumferential: 24\n        axial: 1\n";
+  expect_error(ring, "type: box\n        size: [1, 1, 1]\n        cells: [2, -3, 2]\n", "cells: expected three whole numbers");
+  expect_error(ring, "type: box\n        size: [1, 1, 1]\n        cells: [2, 2.5, 2]\n", "cells: expected three whole numbers");
+  expect_error(ring, "type: box\n        size: [1, 0, 1]\n        cells: [2, 2, 2]\n", "size: expected three positive lengths");
+  expect_error(ring, "type: box\n        size: [1, 1, 1]\n        cells: [1000, 1000, 100]\n",
+               "cells: the product of cells gives 1e+08 hex8 elements");
   std::filesystem::remove_all(dir);
 }
 
