@@ -38,6 +38,15 @@ void Model::begin_step(const Eigen::VectorXd& u, double time, double dt) {
   if (!failure.empty()) throw ElementFailure(failure);
 }
 
+std::string Model::rejects(const Eigen::VectorXd& u, double time, double dt) const {
+  // Every rank holds the same u and every term judges all of its own parts, so
+  // the ranks agree without a message.
+  const SystemState state{u, time, dt, rank, ranks};
+  for (const auto& t : terms)
+    if (std::string why = t->rejects(state); !why.empty()) return why;
+  return {};
+}
+
 int Model::accepted_changes() const {
   int n = 0;
   for (const auto& t : terms) n += t->accepted_changes();

@@ -39,6 +39,8 @@ class Model {
   void accept() { for (auto& t : terms) t->accept(); }
   /// Active-set changes of the last accept() over all terms and ranks.
   int accepted_changes() const;
+  /// The first term's reason not to accept the converged state (u, time, dt), or empty.
+  std::string rejects(const Eigen::VectorXd& u, double time, double dt) const;
   void commit() { for (auto& t : terms) t->commit(); }
   void rollback() { for (auto& t : terms) t->rollback(); }
   /// Restart: every term's committed history under "term/<index>:<name>/".

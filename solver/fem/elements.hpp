@@ -117,6 +117,9 @@ struct Tet10 {
   static constexpr const char* kName = "tet10";
   static constexpr std::array<std::array<int, 2>, 6> kEdges{{{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}}};
   static constexpr auto kRule = tet_4point();
+  // Curved edges let J = det F change sign between the Gauss points and the
+  // corners: the solid kernel checks it at these points too (DESIGN.md §7).
+  static constexpr std::array<std::array<double, 3>, 4> kCornerXi{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
   static ShapeValues<10, 3> eval(const std::array<double, 3>& xi) { return detail::quadratic_simplex<3, 10>(xi, kEdges); }
 };
 

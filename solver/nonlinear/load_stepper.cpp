@@ -35,6 +35,7 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
       NewtonResult nr;
       Eigen::VectorXd guess;
       if (newton.predictor && last_h > 0.0 && last_increment.size() == u.size()) guess = (h / last_h) * last_increment;
+      const Eigen::VectorXd u_start = u;  // a rejected converged state goes back to it
       try {
         model.begin_step(u, t + h, h);
         nr = newton_step(model, system, linear, u, t + h, h, newton, &guess);
@@ -46,6 +47,13 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
       rec.assembly_seconds += nr.assembly_seconds;
       rec.linear_seconds += nr.linear_seconds;
       rec.linear_setup_seconds += nr.linear_setup_seconds;
+      if (nr.converged) {
+        if (std::string why = model.rejects(u, t + h, h); !why.empty()) {
+          nr.converged = false;
+          nr.failure = "converged to a state that cannot be accepted: " + why;
+          u = u_start;
+        }
+      }
       if (nr.converged) {
         model.commit();
         t += h;

@@ -18,6 +18,8 @@ class FollowerPressure : public Term {
                    LoadCurve curve);
   std::string name() const override { return name_; }
   void assemble(const SystemState& state, Assembler& out) override;
+  /// A face turned to its cell's side (face_orientation.hpp): the surface is inside out.
+  std::string rejects(const SystemState& state) const override;
   double pressure(double time) const { return magnitude_ * curve_(time); }
   const std::vector<fem::Face>& faces() const { return faces_; }
 
@@ -29,6 +31,7 @@ class FollowerPressure : public Term {
   std::vector<fem::Face> faces_;
   double magnitude_;
   LoadCurve curve_;
+  std::vector<char> outward_;  // per face: it looks away from its cell in the reference
 };
 
 }  // namespace stentsim::solver

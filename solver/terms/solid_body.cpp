@@ -96,9 +96,14 @@ Vec3 SolidBody::position(const Eigen::VectorXd& u, std::size_t node) const {
   return mesh_.points[node] + u.segment<3>(dof(node, 0));
 }
 
-void SolidBody::fail(const Element& el, const char* type, int point, const char* why) const {
-  throw ElementFailure(fmt::format("body '{}', element {} ({}, material '{}'), quadrature point {}: {}", name_, el.cell, type,
-                                   materials_[static_cast<std::size_t>(el.material)].name, point, why));
+void SolidBody::fail(const Element& el, const char* type, int point, int corner, const char* why) const {
+  std::string where;
+  if (point >= 0) where = fmt::format(", quadrature point {}", point);
+  else if (corner >= 0)
+    where = fmt::format(", corner node {}",
+                        mesh_.connectivity[static_cast<std::size_t>(mesh_.cell_offsets[el.cell]) + static_cast<std::size_t>(corner)]);
+  throw ElementFailure(fmt::format("body '{}', element {} ({}, material '{}'){}: {}", name_, el.cell, type,
+                                   materials_[static_cast<std::size_t>(el.material)].name, where, why));
 }
 
 template <class E>
@@ -119,8 +124,8 @@ void SolidBody::assemble_element(const Element& el, const SystemState& state, As
   ViscousHistory* trial = el.history >= 0 ? &trial_[static_cast<std::size_t>(el.history)] : nullptr;
   const auto res = K::evaluate(xr, xc, materials_[static_cast<std::size_t>(el.material)], fiber_dirs_[el.cell].data(),
                                hist, trial, state.dt, r, tangent ? &k : nullptr);
-  if (!res.status.ok) fail(el, E::kName, res.point, res.status.why);
-  if (!r.allFinite() || (tangent && !k.allFinite())) fail(el, E::kName, -1, "residual or tangent not finite");
+  if (!res.status.ok) fail(el, E::kName, res.point, res.corner, res.status.why);
+  if (!r.allFinite() || (tangent && !k.allFinite())) fail(el, E::kName, -1, -1, "residual or tangent not finite");
   if (tangent) out.add(dofs, r, k);
   else out.add(dofs, r, Eigen::MatrixXd());
 }
@@ -261,7 +266,7 @@ void SolidBody::cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& 
   std::array<Mat3, K::kPoints> points;
   const auto res = K::averages(xr, xc, materials_[static_cast<std::size_t>(el.material)], fiber_dirs_[el.cell].data(),
                                hist, cauchy, strain, volume, points.data());
-  if (!res.status.ok) fail(el, E::kName, res.point, res.status.why);
+  if (!res.status.ok) fail(el, E::kName, res.point, res.corner, res.status.why);
   max_principal = -std::numeric_limits<double>::infinity();
   for (const Mat3& sigma : points)
     max_principal = std::max(max_principal, Eigen::SelfAdjointEigenSolver<Mat3>(sigma, Eigen::EigenvaluesOnly).eigenvalues()[2]);

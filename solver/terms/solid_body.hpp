@@ -83,7 +83,7 @@ class SolidBody : public Term {
   void assemble_any(const Element& el, const SystemState& state, Assembler& out, bool tangent);
   template <class E>
   void cell_average(const Element& el, const Eigen::VectorXd& u, Mat3& cauchy, Mat3& strain, double& max_principal) const;
-  [[noreturn]] void fail(const Element& el, const char* type, int point, const char* why) const;
+  [[noreturn]] void fail(const Element& el, const char* type, int point, int corner, const char* why) const;
 
   std::string name_;
   MeshData mesh_;

@@ -22,7 +22,8 @@ struct SolidElement {
   /// Where a failure happened inside the element.
   struct Outcome {
     PointStatus status;
-    int point = -1;
+    int point = -1;   // quadrature point
+    int corner = -1;  // or element node (E::kCornerXi order = the element's first nodes)
   };
 
   /// Material response at every quadrature point; the caller aggregates.
@@ -47,6 +48,20 @@ struct SolidElement {
       }
   }
 
+  /// The first corner (of E::kCornerXi, for elements whose J varies enough to
+  /// change sign away from the Gauss points: tet10) where J = det F <= 0, or -1.
+  /// sign(J) = sign(det dx/dxi) * sign(det dX/dxi), so no inverse is needed.
+  static int inverted_corner(const NodeMat& x_ref, const NodeMat& x_cur) {
+    if constexpr (requires { E::kCornerXi; }) {
+      for (int c = 0; c < static_cast<int>(E::kCornerXi.size()); ++c) {
+        const auto sv = E::eval(E::kCornerXi[c]);
+        const Mat3 j_cur = x_cur * sv.dn, j_ref = x_ref * sv.dn;
+        if (!(j_cur.determinant() * j_ref.determinant() > 0.0)) return c;
+      }
+    }
+    return -1;
+  }
+
   /// Residual (internal force) and, if `k` is not null, tangent.
   /// `history` (kPoints entries, committed) and `trial` (kPoints entries,
   /// written) are used when the material has a viscous branch; `dt` is the step.
@@ -54,6 +69,8 @@ struct SolidElement {
                           const ViscousHistory* history, ViscousHistory* trial, double dt, Vec& r, Mat* k) {
     r.setZero();
     if (k) k->setZero();
+    if (auto corner = inverted_corner(x_ref, x_cur); corner >= 0)
+      return {PointStatus::fail("J = det F <= 0 (inverted element)"), -1, corner};
     Eigen::Matrix<double, kNodes, 3> g;
     Eigen::Matrix<double, 6, kDofs> b;
     Vec6 s;

@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include "solver/fem/face_orientation.hpp"
 #include "solver/terms/element_failure.hpp"
 #include "solver/terms/follower_pressure.hpp"
 #include "solver/terms/robin_springs.hpp"
@@ -23,7 +24,24 @@ void gather(const SolidBody& body, const fem::Face& f, const Eigen::VectorXd& u,
 
 FollowerPressure::FollowerPressure(std::string name, const SolidBody& body, std::vector<fem::Face> faces, double magnitude,
                                    LoadCurve curve)
-    : name_(std::move(name)), body_(body), faces_(std::move(faces)), magnitude_(magnitude), curve_(std::move(curve)) {}
+    : name_(std::move(name)), body_(body), faces_(std::move(faces)), magnitude_(magnitude), curve_(std::move(curve)) {
+  outward_.reserve(faces_.size());
+  const auto reference = [&](std::size_t node) -> Eigen::Vector3d { return body_.mesh().points[node]; };
+  for (const auto& f : faces_) outward_.push_back(fem::face_side(body_.mesh(), f, reference) < 0.0);
+}
+
+std::string FollowerPressure::rejects(const SystemState& state) const {
+  const auto current = [&](std::size_t node) -> Eigen::Vector3d { return body_.position(state.u, node); };
+  std::size_t flipped = 0, first = 0;
+  for (std::size_t e = 0; e < faces_.size(); ++e)
+    if (outward_[e] && !(fem::face_side(body_.mesh(), faces_[e], current) < 0.0) && flipped++ == 0) first = e;
+  if (flipped == 0) return {};
+  const Vec3 at = body_.position(state.u, static_cast<std::size_t>(faces_[first].nodes[0]));
+  return fmt::format("{} on body '{}': {} of {} loaded faces turned inside out or collapsed (they face their own cells), "
+                     "the first of cell {} at ({:.4g}, {:.4g}, {:.4g}); the pressure is likely far beyond what the "
+                     "body can carry, or the first step too large",
+                     name_, body_.name(), flipped, faces_.size(), faces_[first].cell, at.x(), at.y(), at.z());
+}
 
 template <class S>
 void FollowerPressure::add_face(const fem::Face& f, const SystemState& state, double p, Assembler& out, bool tangent) const {

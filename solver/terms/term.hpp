@@ -100,6 +100,12 @@ class Term {
   /// Points whose active state (contact) the last accept() changed on this rank: Newton's
   /// residual-floor test needs a settled active set (newton.hpp).
   virtual int accepted_changes() const { return 0; }
+  /// Why this term cannot accept the converged state `state` (empty: it can).
+  /// Some converged states are spurious: a loaded surface turned inside out
+  /// balances its pressure as well as a real one does (face_orientation.hpp).
+  /// Asked before commit() on every rank with the same u; a reason cuts the step
+  /// like a failed iteration (DESIGN.md §7).
+  virtual std::string rejects(const SystemState& state) const { return {}; }
   /// The load step converged: history and reference states move forward.
   virtual void commit() {}
   /// The load step is cut: go back to the last committed state.

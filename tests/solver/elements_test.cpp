@@ -176,6 +176,34 @@ MeshData distorted_patch(CellType type) {
   return m;
 }
 
+// A tet10 whose mid-edge node 4 (edge 0-1) moves by d along the edge has
+// J = 1 + 4 d (L0 - L1): at d = 0.4 it is positive at the four Gauss points
+// (at least 1 - 1.789 d = 0.28) and -0.6 at corner 1. Such an element is
+// inverted and must fail, naming the corner; at d = 0.2 (J = 0.2 there) it is fine.
+TEST(SolverElements, Tet10InvertedAtACornerBetweenPositiveGaussPointsFails) {
+  using K = SolidElement<fem::Tet10>;
+  Material nh;
+  nh.name = "nh";
+  nh.matrix = CoupledNeoHooke::from_young_poisson(1.0, 0.45);
+  const K::NodeMat xr = reference_nodes<fem::Tet10>();
+  std::array<Vec3, kMaxFiberFamilies> dirs{};
+  auto evaluate = [&](double d) {
+    K::NodeMat xc = xr;
+    xc(0, 4) += d;
+    K::Vec r;
+    K::Mat k;
+    return K::evaluate(xr, xc, nh, dirs.data(), nullptr, nullptr, 1.0, r, &k);
+  };
+  const auto bad = evaluate(0.4);
+  EXPECT_FALSE(bad.status.ok);
+  EXPECT_EQ(bad.corner, 1);
+  EXPECT_EQ(bad.point, -1);
+  EXPECT_NE(std::string(bad.status.why).find("inverted"), std::string::npos);
+  const auto fine = evaluate(0.2);
+  EXPECT_TRUE(fine.status.ok) << fine.status.why;
+  EXPECT_EQ(K::inverted_corner(xr, xr), -1);
+}
+
 TEST(SolverElements, PatchTests) {
   for (CellType type : {CellType::hexahedron, CellType::tetra, CellType::quadratic_tetra}) {
     SolidBodySpec spec;

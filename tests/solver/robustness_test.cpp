@@ -5,7 +5,10 @@
 //  - only a failure at the minimum step stops the run, with that message;
 //  - the tube above its asymptotic pressure stops with "no converged state
 //    beyond p = ..." instead of creeping, and writes the last converged state
-//    (PVD, history.csv, summary.yaml marked failed, status != 0).
+//    (PVD, history.csv, summary.yaml marked failed, status != 0);
+//  - a converged state whose loaded surface turned inside out (the tube at
+//    1e5 MPa: the lumen passes through the axis and its flipped, shrunken
+//    faces balance the pressure) is a failed step, never a result.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -16,6 +19,7 @@
 #include <string>
 
 #include "common/files.hpp"
+#include "common/log.hpp"
 #include "common/mesh_data.hpp"
 #include "common/summary.hpp"
 #include "solver/app/solve.hpp"
@@ -229,6 +233,83 @@ TEST(SolverRobustness, TubeAboveItsAsymptoticPressureStopsCleanly) {
   for (const auto& [name, a] : frame.cell_data)
     for (double v : a.values) ASSERT_TRUE(std::isfinite(v)) << name;
   std::filesystem::remove_all(dir);
+}
+
+// examples/tube_inflation.yaml at 1e5 MPa (1e5 x E): the first step's Newton
+// run converges in 14 iterations to the inner surface reflected through the
+// axis at r = 4e-5 mm, J > 0 at every quadrature point, which the solver once
+// reported as completed. Now every such state is cut and the run stops at the
+// minimum step without accepting one.
+TEST(SolverRobustness, ALumenTurnedInsideOutIsNeverAcceptedAsConverged) {
+  const auto dir = std::filesystem::temp_directory_path() / ("stentsim_everted_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::string text = files::read_text(std::filesystem::path(STENTSIM_TEST_SOURCE_DIR) / "examples/tube_inflation.yaml");
+  const auto at = text.find("value: 0.12 MPa");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 15, "value: 100000 MPa");
+  files::write_atomic(dir / "scene.yaml", text);
+  SolveOptions o;
+  o.output_dir = dir / "out";
+  log::set_file(dir / "solve.log");
+  const int status = solve_scene(dir / "scene.yaml", o);
+  log::set_file({});
+  EXPECT_NE(status, 0);
+  const Summary s = Summary::read(dir / "out/summary.yaml");
+  EXPECT_EQ(std::get<std::string>(s.qois().at("status").value), "failed");
+  EXPECT_EQ(std::get<double>(s.qois().at("final_time").value), 0.0) << "no step may be accepted";
+  const std::string log_text = files::read_text(dir / "solve.log");
+  EXPECT_NE(log_text.find("converged to a state that cannot be accepted: lumen_pressure on body 'tube': 24 of 24 loaded "
+                          "faces turned inside out"),
+            std::string::npos)
+      << log_text;
+  std::filesystem::remove_all(dir);
+}
+
+// The judge itself: the inner faces of a ring reflected through the axis (a
+// rotation by pi in the cross-section, orientation-preserving, so J keeps its
+// sign) are inside out; expanded, compressed or rigidly moved they are not.
+TEST(SolverRobustness, FollowerPressureRejectsOnlyAnInsideOutSurface) {
+  SolidBodySpec spec;
+  spec.name = "tube";
+  spec.mesh = ring_sector_hex8(0.8, 1.4, M_PI / 2, 0.05, 4, 12, 1);
+  spec.cell_material.assign(spec.mesh.num_cells(), 0);
+  Material m;
+  m.name = "wall";
+  m.matrix = CoupledNeoHooke::from_young_poisson(1.0, 0.45);
+  spec.materials = {m};
+  Model model;
+  const GlobalDof first = model.dofs.allocate("tube", 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
+  auto& body = model.add_term<SolidBody>(spec, first);
+  std::vector<fem::Face> inner;
+  for (const auto& f : fem::boundary_faces(body.mesh())) {
+    bool on = true;
+    for (int i = 0; i < f.count; ++i)
+      on = on && std::abs(body.mesh().points[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(i)])].head<2>().norm() -
+                          0.8) < 1e-9;
+    if (on) inner.push_back(f);
+  }
+  ASSERT_EQ(inner.size(), 12u);
+  FollowerPressure p("lumen", body, inner, 1.0, LoadCurve::ramp(0, 1));
+  auto state_of = [&](auto map) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(model.dofs.size());
+    for (std::size_t n = 0; n < body.num_nodes(); ++n) {
+      const Vec3 x = body.mesh().points[n];
+      u.segment<3>(body.dof(n, 0)) = map(x) - x;
+    }
+    return u;
+  };
+  auto judge = [&](const Eigen::VectorXd& u) { return p.rejects(SystemState{u, 1.0, 1.0}); };
+  EXPECT_EQ(judge(state_of([](const Vec3& x) { return x; })), "");
+  EXPECT_EQ(judge(state_of([](const Vec3& x) { return Vec3(1.5 * x.x(), 1.5 * x.y(), x.z()); })), "");
+  EXPECT_EQ(judge(state_of([](const Vec3& x) { return Vec3(0.01 * x.x(), 0.01 * x.y(), x.z()); })), "");
+  EXPECT_EQ(judge(state_of([](const Vec3& x) { return Vec3(-x.y() + 3.0, x.x(), x.z() + 1.0); })), "");
+  // The inner ring through the axis to r = 4e-5 mm, the rest in place.
+  const std::string why = judge(state_of([](const Vec3& x) {
+    const double r = x.head<2>().norm();
+    return std::abs(r - 0.8) < 1e-9 ? Vec3(-5e-5 * x.x(), -5e-5 * x.y(), x.z()) : x;
+  }));
+  EXPECT_NE(why.find("lumen on body 'tube': 12 of 12 loaded faces turned inside out"), std::string::npos) << why;
 }
 
 }  // namespace
