@@ -191,6 +191,11 @@ void check_nifti_header(const std::filesystem::path& file) {
     if (dim[i] < 1) throw InputError(fmt::format("{}: NIfTI dim[{}] is {:g}; every axis needs at least one voxel", name, i, dim[i]));
     if (!std::isfinite(pixdim[i]))
       throw InputError(fmt::format("{}: NIfTI pixdim[{}] is not a finite number", name, i));
+    // VTK's reader reads a zero voxel size as given (a flat image whose surface
+    // collapses); the three spatial axes need a positive one.
+    if (i <= 3 && pixdim[i] == 0)
+      throw InputError(fmt::format("{}: NIfTI pixdim[{}] is 0: axis {} has zero spacing; the voxel size must be positive "
+                                   "(a header written without its voxel size?)", name, i, i));
     need *= dim[i];
   }
   if (!std::isfinite(pixdim[0])) throw InputError(fmt::format("{}: NIfTI pixdim[0] (qfac) is not a finite number", name));

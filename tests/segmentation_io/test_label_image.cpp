@@ -396,6 +396,33 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
   }
   e = error_of(dir / "flat.nrrd");
   EXPECT_NE(e.find("axis 2 has zero spacing"), std::string::npos) << e;
+  // ... in a MetaImage header (ElementSpacing) and in a NIfTI one (pixdim[3], the z axis).
+  {
+    std::ofstream f(dir / "flat.mha", std::ios::binary);
+    f << "ObjectType = Image\nNDims = 3\nDimSize = " << kDim[0] << " " << kDim[1] << " " << kDim[2]
+      << "\nElementSpacing = " << kSp[0] << " 0 " << kSp[2] << "\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n";
+    f.write(static_cast<const char*>(im->GetScalarPointer()), voxels);
+  }
+  e = error_of(dir / "flat.mha");
+  EXPECT_NE(e.find("flat.mha"), std::string::npos) << e;
+  EXPECT_NE(e.find("ElementSpacing = '0.1 0 0.15'"), std::string::npos) << e;
+  EXPECT_NE(e.find("non-zero"), std::string::npos) << e;
+  {
+    auto w = vtkSmartPointer<vtkNIFTIImageWriter>::New();
+    w->SetInputData(im);
+    w->SetFileName((dir / "flat.nii").c_str());
+    w->Write();
+  }
+  {
+    // NIfTI-1: float pixdim[8] at byte 76; pixdim[3] is the third axis's spacing.
+    std::fstream f(dir / "flat.nii", std::ios::in | std::ios::out | std::ios::binary);
+    const float zero_spacing = 0.0f;
+    f.seekp(76 + 3 * 4);
+    f.write(reinterpret_cast<const char*>(&zero_spacing), 4);
+  }
+  e = error_of(dir / "flat.nii");
+  EXPECT_NE(e.find("flat.nii"), std::string::npos) << e;
+  EXPECT_NE(e.find("pixdim[3] is 0: axis 3 has zero spacing"), std::string::npos) << e;
   fs::remove_all(dir);
 }
 

@@ -26,6 +26,7 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/log.hpp"
 #include "segmentation_io/label_image.hpp"
 #include "segmentation_io/simvascular_io.hpp"
 #include "segmentation_io/centerline.hpp"
@@ -174,13 +175,24 @@ TEST(SurfaceReaders, BinaryStlBySizeRule) {
   EXPECT_CONTAINS(cut, "cut.stl");
   EXPECT_CONTAINS(cut, "cut short");
   EXPECT_CONTAINS(cut, std::to_string(ref.num_triangles()) + " triangles");
-  // Trailing bytes: read (with a warning), the same surface.
+  // Trailing bytes: read with a warning that names the file and the extra bytes, the same surface.
+  log::set_file(d / "warnings.log");
   EXPECT_EQ(read_surface_file(write("longer.stl", bytes + std::string(10, '\0'))).num_triangles(), ref.num_triangles());
-  // A header claiming 2^31 triangles in a small file: the size rule, no allocation.
+  log::set_file({});
+  const std::string warned = stentsim::files::read_text(d / "warnings.log");
+  EXPECT_CONTAINS(warned, "warning");
+  EXPECT_CONTAINS(warned, "longer.stl");
+  EXPECT_CONTAINS(warned, "10");
+  // A header claiming 2^31 triangles in a small file: the size rule names the file,
+  // the count and the size it would need, before anything is allocated.
   std::string huge = bytes;
   const std::uint32_t n = 1u << 31;
   std::memcpy(huge.data() + 80, &n, 4);
-  EXPECT_CONTAINS(error_of([&] { read_surface_file(write("huge.stl", huge)); }), "2147483648 triangles");
+  const std::string huge_error = error_of([&] { read_surface_file(write("huge.stl", huge)); });
+  EXPECT_CONTAINS(huge_error, "huge.stl");
+  EXPECT_CONTAINS(huge_error, "2147483648 triangles");
+  EXPECT_CONTAINS(huge_error, "cut short");
+  EXPECT_CONTAINS(huge_error, std::to_string(84ull + 50ull * n));
   // A NaN coordinate, named by triangle and vertex.
   std::string nan = bytes;
   const float q = std::numeric_limits<float>::quiet_NaN();
