@@ -19,12 +19,14 @@
 #include <fstream>
 #include <optional>
 
+#include "common/child_process.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "segmentation_io/legacy_vtk_ascii.hpp"
 #include "segmentation_io/stl_binary.hpp"
 #include "segmentation_io/surface_input.hpp"
 #include "common/vtk_read_errors.hpp"
+#include "common/vtk_smp.hpp"
 
 namespace stentsim::segmentation {
 
@@ -78,7 +80,16 @@ TriSurface read_surface_file(const std::filesystem::path& file) {
     reader = r;
   } else if (ext == ".vtk") {
     if (std::optional<TriSurface> ascii = read_legacy_vtk_ascii(file)) return finite_checked(std::move(*ascii), file);
-    auto r = vtkSmartPointer<vtkPolyDataReader>::New();  // BINARY
+    // BINARY: VTK's legacy reader trusts the counts before each raw section and
+    // crashes inside itself on a damaged one (mutation fuzzing found it), so it
+    // reads the file in a child first.
+    process::probe_read_in_child(file, "legacy VTK", [&] {
+      use_sequential_vtk_smp();  // the forked child has none of the parent's TBB workers
+      auto probe = vtkSmartPointer<vtkPolyDataReader>::New();
+      probe->SetFileName(file.c_str());
+      probe->Update();
+    });
+    auto r = vtkSmartPointer<vtkPolyDataReader>::New();
     r->SetFileName(file.c_str());
     if (!r->IsFilePolyData())
       throw InputError(fmt::format("{}: not a legacy VTK file with POLYDATA (an unstructured grid or image is not a surface)",

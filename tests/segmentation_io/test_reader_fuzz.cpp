@@ -91,6 +91,18 @@ std::string vtk51_text(const fs::path& dir, const TriSurface& s) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
+// ... and in its binary form (big-endian arrays after each keyword line): mutants
+// reach the counts and the raw offsets and connectivity.
+std::string vtk51_binary(const fs::path& dir, const TriSurface& s) {
+  auto w = vtkSmartPointer<vtkPolyDataWriter>::New();
+  w->SetInputData(to_polydata(s));
+  w->SetFileTypeToBinary();
+  w->SetFileName((dir / "seed51b.vtk").c_str());
+  w->Write();
+  std::ifstream in(dir / "seed51b.vtk", std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 std::string vtp_text(const fs::path& dir, const TriSurface& s) {
   write_vtp((dir / "seed.vtp").string(), mesh_from_surface(s));
   std::ifstream in(dir / "seed.vtp", std::ios::binary);
@@ -107,7 +119,8 @@ TEST(ReaderFuzz, MutatedSurfacesReadOrFailWithAnInputError) {
   // read_surface_file reads such a file in a child process first (check_vtk_xml_file).
   std::map<std::string, std::string> seeds = {{"ascii.stl", ascii_stl(tube)}, {"binary.stl", binary_stl(tube)},
                                               {"t.obj", obj(tube)}, {"t.vtk", legacy_vtk(tube)},
-                                              {"t51.vtk", vtk51_text(dir, tube)}, {"t.vtp", vtp_text(dir, tube)}};
+                                              {"t51.vtk", vtk51_text(dir, tube)}, {"t51b.vtk", vtk51_binary(dir, tube)},
+                                              {"t.vtp", vtp_text(dir, tube)}};
   std::mt19937 gen(20261202);
   const int n = fuzz::iterations();
   for (const auto& [name, seed] : seeds) {

@@ -258,6 +258,30 @@ TEST(SurfaceReaders, FifosAndDevicesAreRefusedWithoutReading) {
   fs::remove_all(d);
 }
 
+// A binary legacy VTK file whose version line is damaged ("5.1" -> "nan.1", a fuzz
+// mutant): VTK's reader then takes the 5.1 sections for the old layout and crashed
+// the process (SIGSEGV) on the raw OFFSETS; now the file is refused by name. The
+// binary file as written, and one with its version line intact, still read.
+TEST(SurfaceReaders, DamagedBinaryLegacyVtkIsRefusedNotACrash) {
+  const fs::path d = temp_dir("legacy_vtk_binary");
+  const TriSurface ref = small_tube();
+  auto w = vtkSmartPointer<vtkPolyDataWriter>::New();
+  w->SetInputData(to_polydata(ref));
+  w->SetFileTypeToBinary();
+  w->SetFileName((d / "good.vtk").c_str());
+  w->Write();
+  EXPECT_EQ(read_surface_file(d / "good.vtk").num_triangles(), ref.num_triangles());
+  std::string text = stentsim::files::read_text(d / "good.vtk");
+  const auto at = text.find("Version 5.1");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 11, "Version nan.1");
+  std::ofstream(d / "damaged.vtk", std::ios::binary) << text;
+  const std::string e = error_of([&] { read_surface_file(d / "damaged.vtk"); });
+  EXPECT_CONTAINS(e, (d / "damaged.vtk").string());
+  EXPECT_CONTAINS(e, "legacy VTK");
+  fs::remove_all(d);
+}
+
 // Legacy VTK as VTK 9.1's writer makes it (5.1: OFFSETS/CONNECTIVITY, dataset FIELD data
 // before the points, polygons and a triangle strip): stentsim's parser gives VTK's own
 // triangulation, orientation included.
