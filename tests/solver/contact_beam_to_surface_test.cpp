@@ -414,3 +414,85 @@ TEST(BeamContact, ForceAcrossAConcaveKinkIsContinuous) {
 
 }  // namespace
 }  // namespace stentsim::solver
+
+namespace stentsim::solver {
+namespace {
+
+/// u with the beam's centerline moved by dz (positions only; the surface stays).
+Eigen::VectorXd beam_lifted(Setup& s, double dz) {
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(s.model.dofs.size());
+  for (const auto& n : s.beam->dofs())
+    if (n.pos[2] >= 0) u[n.pos[2]] = dz;
+  return u;
+}
+
+// The search runs once per step and again only when a point moved more than
+// half the search margin (0.2 mm here) since: a move of 0.09 mm reuses it, one of
+// 0.11 mm searches again; so does a surface node that moved as far.
+TEST(BeamContact, SearchRunsAgainOnlyWhenAPointMovedPastHalfTheMargin) {
+  auto s = make_setup(Mesh::hex8, kR + 0.05, 2);
+  const Eigen::VectorXd u0 = Eigen::VectorXd::Zero(s->model.dofs.size());
+  s->pair->begin_step(SystemState{u0, 1.0, 1.0});
+  assemble_pair(*s->pair, u0);
+  const long long first = s->pair->searches();
+  EXPECT_GE(first, 1);
+  assemble_pair(*s->pair, beam_lifted(*s, -0.09));
+  EXPECT_EQ(s->pair->searches(), first) << "within half the margin: the last search holds";
+  assemble_pair(*s->pair, beam_lifted(*s, -0.11));
+  EXPECT_EQ(s->pair->searches(), first + 1) << "past half the margin: searched again";
+  // From the new search's positions a move back by 0.11 mm is again past half the margin.
+  assemble_pair(*s->pair, beam_lifted(*s, 0.0));
+  EXPECT_EQ(s->pair->searches(), first + 2);
+  // A surface node moved by 0.11 mm.
+  Eigen::VectorXd u = u0;
+  u[s->solid->dof(static_cast<std::size_t>(s->faces[0].nodes[0]), 2)] = 0.11;
+  assemble_pair(*s->pair, u);
+  EXPECT_EQ(s->pair->searches(), first + 3);
+  // The next step's begin_step searches once more.
+  s->pair->begin_step(SystemState{u, 2.0, 1.0});
+  assemble_pair(*s->pair, u);
+  EXPECT_EQ(s->pair->searches(), first + 4);
+}
+
+// Points flipping in and out of contact between accepted Newton iterates more
+// than max_flips times in one step make the iteration fail (the stepper cuts the
+// step) instead of Newton cycling for ever; a new step starts the count again,
+// and a rejected line-search trial (assembled, never accepted) adds nothing.
+TEST(BeamContact, ChatteringPastMaxFlipsFailsTheIteration) {
+  auto s = make_setup(Mesh::hex8, kR + 0.01, 1);
+  const int max_flips = s->pair->settings().max_flips;
+  ASSERT_GT(max_flips, 1);
+  const Eigen::VectorXd in = beam_lifted(*s, -0.03), out = beam_lifted(*s, 0.0);  // penetrating by 0.02, apart by 0.01
+  auto run_step = [&](int flips) {
+    s->pair->begin_step(SystemState{out, 1.0, 1.0});
+    assemble_pair(*s->pair, out);
+    s->pair->accept();
+    for (int k = 1; k <= flips; ++k) {
+      assemble_pair(*s->pair, k % 2 ? in : out);
+      s->pair->accept();
+    }
+  };
+  EXPECT_NO_THROW(run_step(max_flips));
+  s->pair->rollback();
+  // A rejected trial in between: assembled at the penetrating state, not accepted.
+  s->pair->begin_step(SystemState{out, 1.0, 1.0});
+  assemble_pair(*s->pair, out);
+  s->pair->accept();
+  for (int k = 0; k < 3 * max_flips; ++k) assemble_pair(*s->pair, in);
+  assemble_pair(*s->pair, out);
+  EXPECT_NO_THROW(s->pair->accept());
+  s->pair->rollback();
+  try {
+    run_step(max_flips + 1);
+    ADD_FAILURE() << "no failure after " << max_flips + 1 << " flips";
+  } catch (const ElementFailure& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("active-set chattering"), std::string::npos) << w;
+    EXPECT_NE(w.find("max_flips = " + std::to_string(max_flips)), std::string::npos) << w;
+  }
+  s->pair->rollback();
+  EXPECT_NO_THROW(run_step(max_flips)) << "a new step counts from zero";
+}
+
+}  // namespace
+}  // namespace stentsim::solver
