@@ -11,6 +11,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "common/self_intersection.hpp"
 #include "segmentation_io/surface_input.hpp"
 
 namespace stentsim::segmentation {
@@ -276,7 +277,7 @@ TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& o, const st
   }
 
   if (o.check_self_intersections) {
-    auto pairs = self_intersections(s, 20);
+    auto pairs = self_intersecting_triangles(s.points, s.triangles, 20);
     if (!pairs.empty())
       fail(fmt::format("the surface intersects itself ({}{} pairs of triangles, the first near {}); fix it in the "
                        "segmentation tool (e.g. smooth or remesh the region)", pairs.size() >= 20 ? "at least " : "",

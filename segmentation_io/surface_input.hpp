@@ -70,8 +70,4 @@ struct SurfaceReport {
 TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& options, const std::string& what,
                             SurfaceReport& report);
 
-/// Pairs of triangles that intersect other than along shared edges/vertices
-/// (CGAL Polygon Mesh Processing); at most `limit` pairs.
-std::vector<std::pair<int, int>> self_intersections(const TriSurface& s, std::size_t limit = 20);
-
 }  // namespace stentsim::segmentation

@@ -32,6 +32,8 @@ struct BuiltModel {
   std::vector<std::unique_ptr<RunObserver>> observers;
   /// Beam bodies whose strut overlap is checked (contact pairs add the check once per beam).
   std::set<std::string> overlap_checked_beams;
+  /// Solid bodies whose contact surface is checked for self-intersection (once per body).
+  std::set<std::string> self_intersection_checked_solids;
   /// Lines for summary.yaml's notes (materials, laws, penalties).
   std::vector<std::string> notes;
   /// Node first DOF -> condition name, for conflicting solid Dirichlet conditions.

@@ -85,6 +85,10 @@ TEST(ContactScene, RingIsExpandedByTheBalloonAloneAndPenaltyActsAsExpected) {
   EXPECT_GT(force, 0.0);
   EXPECT_LT(reaction, 1e-2 * force);    // the fixations only keep the ring from drifting
   EXPECT_EQ(qoi(a, "contact_active_points_stent_balloon_after"), 0.0);  // the deflated balloon has let go
+  // Neither the struts (no beam–beam contact) nor the balloon's surface (no self-contact) overlap.
+  EXPECT_EQ(qoi(a, "strut_overlap_points_max_stent"), 0.0);
+  EXPECT_EQ(qoi(a, "self_intersection_pairs_max_balloon"), 0.0);
+  EXPECT_EQ(qoi(a, "self_intersection_first_time_balloon"), -1.0);
 
   // Malapposition. Initially every strut is 0.025 mm from the balloon's round surface, up to
   // 0.49 (1 - cos(pi / 29)) = 0.0029 mm more over the middle of its 29 chord faces.

@@ -33,6 +33,7 @@
 #include "solver/app/built_model.hpp"
 #include "solver/app/contact/registry.hpp"
 #include "solver/app/contact/strut_overlap.hpp"
+#include "solver/app/contact/surface_self_intersection.hpp"
 #include "solver/app/run_observer.hpp"
 #include "solver/contact/beam_to_surface_pair.hpp"
 #include "solver/io/selection.hpp"
@@ -201,6 +202,9 @@ class BeamToSurfaceSpec : public ContactSpec {
     m.observers.push_back(std::make_unique<BeamToSurfaceOutput>(pair, times, scene.stepping.t_end));
     // Beam–beam contact is not modelled: overlapping struts are detected and warned about (once per beam).
     if (m.overlap_checked_beams.insert(beam).second) m.observers.push_back(make_strut_overlap_check(beam_term, s.radius));
+    // Nor is self-contact of the solid: a surface folded through itself is detected and warned about.
+    if (m.self_intersection_checked_solids.insert(solid).second)
+      m.observers.push_back(make_surface_self_intersection_check(pair.surface(), solid));
   }
 };
 

@@ -28,6 +28,7 @@
 #include "solver/app/body_surfaces.hpp"
 #include "solver/app/built_model.hpp"
 #include "solver/app/contact/registry.hpp"
+#include "solver/app/contact/surface_self_intersection.hpp"
 #include "solver/app/run_observer.hpp"
 #include "solver/contact/surface_to_surface_pair.hpp"
 #include "solver/io/selection.hpp"
@@ -172,6 +173,11 @@ class SurfaceToSurfaceSpec : public ContactSpec {
                                   "integration {}x{}), slave {} master {}, epsilon {:g} N/mm^3, frictionless",
                                   name, set.gauss_points, set.gauss_points, slave.body, master.body, set.law.epsilon));
     m.observers.push_back(std::make_unique<SurfaceToSurfaceOutput>(pair, slave.body, times, scene.stepping.t_end));
+    // Self-contact is not modelled: a surface folded through itself is detected and warned about.
+    if (m.self_intersection_checked_solids.insert(slave.body).second)
+      m.observers.push_back(make_surface_self_intersection_check(pair.slave(), slave.body));
+    if (m.self_intersection_checked_solids.insert(master.body).second)
+      m.observers.push_back(make_surface_self_intersection_check(pair.master(), master.body));
   }
 };
 
