@@ -60,10 +60,12 @@ StageChild start_stage(const Stage& stage, const std::filesystem::path& work_dir
         log::error("{}", e.what());
         child_exit(fds[1], kExitInput, e.what());
       } catch (const std::exception& e) {
-        log::error("{}", e.what());
-        child_exit(fds[1], kExitCompute, e.what());
+        const std::string message = describe_unexpected(e);
+        log::error("{}", message);
+        child_exit(fds[1], kExitCompute, message);
       } catch (...) {
-        child_exit(fds[1], kExitCompute, "unknown error");
+        log::error("{}", describe_unknown());
+        child_exit(fds[1], kExitCompute, describe_unknown());
       }
     });
   } catch (const ComputeError& e) {

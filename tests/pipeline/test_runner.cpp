@@ -219,6 +219,24 @@ TEST_F(RunnerTest, FailedStageKeepsItsPartialOutputsForTheUser) {
   EXPECT_FALSE(fs::exists(work / "failed" / "b"));
 }
 
+// What a library or the standard library throws reaches the user worded, never as its bare
+// text ("std::bad_alloc", "vector::_M_range_check"), and is a failed computation.
+TEST_F(RunnerTest, AStandardExceptionIsWordedNotPrintedRaw) {
+  for (const auto& [what, expect] : std::vector<std::pair<std::string, std::string>>{
+           {"oom", "out of memory: this input needs more memory"},
+           {"bounds", "internal error (please report it with the input that caused it): "},
+           {"throw int", "internal error (please report it with the input that caused it): an unknown exception"}}) {
+    fs::remove_all(work);
+    config["a"] = what;
+    auto rep = run();
+    EXPECT_EQ(rep.exit_code(), 1) << what;
+    EXPECT_NE(rep.first_failure.find(expect), std::string::npos) << what << ": " << rep.first_failure;
+    EXPECT_EQ(rep.first_failure.find("std::"), std::string::npos) << rep.first_failure;
+    EXPECT_EQ(rep.first_failure_kind, ErrorKind::compute) << what;
+    EXPECT_EQ(last_output.find("terminate"), std::string::npos) << last_output;
+  }
+}
+
 TEST_F(RunnerTest, CrashingStageDoesNotTakeTheRunnerDown) {
   config["d"] = "crash";
   auto rep = run();

@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <new>
 #include <string>
+#include <vector>
 #include <thread>
 
 #include "common/error.hpp"
@@ -24,7 +26,7 @@ inline int run_count(const std::filesystem::path& counters, const std::string& s
 }
 
 /// A stage `name` reading `inputs`, writing `output`. Its config may contain
-/// the words "fail", "crash" or "sleep" to fail, abort or sleep 30 s; "halfway"
+/// the words "fail", "crash" or "sleep" to fail, abort or sleep 30 s ("oom", "bounds", "throw int": std::bad_alloc, a failed bounds check, a non-exception); "halfway"
 /// writes its output and then fails.
 inline pipeline::Stage concat_stage(const std::string& name, std::vector<std::string> inputs, const std::string& output,
                                     const std::string& config, const std::filesystem::path& counters) {
@@ -59,6 +61,9 @@ inline pipeline::Stage concat_stage(const std::string& name, std::vector<std::st
       return;
     }
     if (config.find("crash") != std::string::npos) std::abort();
+    if (config.find("oom") != std::string::npos) throw std::bad_alloc();
+    if (config.find("bounds") != std::string::npos) (void)std::vector<int>().at(3);
+    if (config.find("throw int") != std::string::npos) throw 42;
     if (config.find("halfway") != std::string::npos) {
       // Writes what a solve that diverged leaves (its last frame), then fails.
       files::write_atomic(ctx.output(output), "last converged\n");

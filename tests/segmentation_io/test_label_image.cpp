@@ -9,12 +9,18 @@
 #include <vtkNIFTIImageWriter.h>
 #include <vtkSmartPointer.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
 #include <sstream>
+#include <string>
+#include <vector>
+#include <tuple>
 
 #include <Eigen/Geometry>
 
@@ -338,6 +344,50 @@ TEST(LabelImage, MetaImageTransformMatrixRotatesAndMirrors) {
   fs::remove_all(dir);
 }
 
+// A detached voxel file (MetaImage ElementDataFile, NRRD "data file:") that is a
+// device or a pipe is refused before VTK opens it: reading /dev/zero would never
+// end and a FIFO would block. A missing one is named too.
+TEST(LabelImage, DetachedDataFileThatIsADeviceOrAPipeIsRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("stentsim_label_detached_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
+  auto error_of = [](const fs::path& f) -> std::string {
+    LabelSurfaceOptions o;
+    o.labels = {1};
+    try {
+      label_image_surface(f, o);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  auto mhd = [&](const std::string& name, const std::string& data) {
+    std::ofstream f(dir / name);
+    f << "ObjectType = Image\nNDims = 3\nDimSize = " << kDim[0] << " " << kDim[1] << " " << kDim[2]
+      << "\nElementSpacing = " << kSp[0] << " " << kSp[1] << " " << kSp[2] << "\nElementType = MET_UCHAR\nElementDataFile = " << data
+      << "\n";
+    return dir / name;
+  };
+  auto nhdr = [&](const std::string& name, const std::string& data) {
+    std::ofstream f(dir / name);
+    f << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << kDim[0] << " " << kDim[1] << " " << kDim[2] << "\nspacings: " << kSp[0]
+      << " " << kSp[1] << " " << kSp[2] << "\nencoding: raw\ndata file: " << data << "\n\n";
+    return dir / name;
+  };
+  for (const auto& [file, key, data] : std::vector<std::tuple<fs::path, std::string, std::string>>{
+           {mhd("zero.mhd", "/dev/zero"), "ElementDataFile", "/dev/zero"},
+           {mhd("pipe.mhd", "pipe"), "ElementDataFile", "pipe"},
+           {nhdr("zero.nhdr", "/dev/zero"), "data file", "/dev/zero"},
+           {nhdr("pipe.nhdr", "pipe"), "data file", "pipe"}}) {
+    const std::string e = error_of(file);
+    EXPECT_NE(e.find(file.string() + ": " + key + " " + data + " is not a regular file"), std::string::npos) << e;
+  }
+  const std::string e = error_of(mhd("missing.mhd", "nothing.raw"));
+  EXPECT_NE(e.find("ElementDataFile nothing.raw is missing"), std::string::npos) << e;
+  fs::remove_all(dir);
+}
+
 // A label image cut short (a copy that did not finish) is named as such, in each
 // format, instead of surfacing the zeros VTK fills in; a zero spacing is named.
 TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
@@ -376,6 +426,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
     f.write(static_cast<const char*>(im->GetScalarPointer()), voxels / 2);
   }
   std::string e = error_of(dir / "labels.nrrd");
+  EXPECT_NE(e.find("labels.nrrd"), std::string::npos) << e;
   EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
   {
     auto w = vtkSmartPointer<vtkMetaImageWriter>::New();
@@ -386,6 +437,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
   }
   cut(dir / "labels.mha", fs::file_size(dir / "labels.mha") - std::uintmax_t(voxels / 2));
   e = error_of(dir / "labels.mha");
+  EXPECT_NE(e.find("labels.mha"), std::string::npos) << e;
   EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
   // A zero spacing in the header.
   {

@@ -11,10 +11,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "common/files.hpp"
 #include "common/summary.hpp"
+#include "segmentation_io/surface_input.hpp"
 #include "tests/workflows/cli_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -184,6 +186,8 @@ TEST_F(Cli, StandAloneCenterlineChecksItsSurfaceAsTheCasePathDoes) {
   EXPECT_FALSE(fs::exists(dir / "c2/centerline.vtp"));
   r = sh("centerline --lumen " + d + "/lumen.stl --units parsecs --out " + d + "/c3/centerline.vtp");
   EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--units"), std::string::npos) << r.out;  // the option and its values named
+  EXPECT_NE(r.out.find("mm"), std::string::npos) << r.out;
 }
 
 // The units rule and the spacing bounds hold for the stand-alone tool as for a case: a
@@ -206,6 +210,55 @@ TEST_F(Cli, StandAloneCenterlineRefusesMisdeclaredUnitsAndSpacing) {
     EXPECT_NE(r.out.find("--spacing"), std::string::npos) << r.out;
   }
   EXPECT_FALSE(fs::exists(dir / "s/centerline.vtp"));
+}
+
+// A lumen damaged in ways a reader cannot see (one vertex's coordinate with its sign flipped, a
+// triangle pointing at a wrong but valid vertex, a vertex shifted far off) is refused by the
+// stand-alone centerline tool's surface checks, exit 2 naming the file, and no centerline of
+// the damage (once: a 99 % "stenosis") is written.
+TEST_F(Cli, StandAloneCenterlineRefusesACorruptedSurface) {
+  const std::string d = dir.string();
+  auto r = sh("phantom --preset case2-rca --out " + d + "/ph");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto lumen = stentsim::segmentation::read_surface_file(dir / "ph/lumen.vtp");
+  auto write_obj = [&](const std::string& name, const stentsim::segmentation::TriSurface& s) {
+    std::ofstream f(dir / name);
+    f.precision(17);
+    for (const auto& p : s.points) f << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (const auto& t : s.triangles) f << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+  };
+  write_obj("intact.obj", lumen);
+  r = sh("centerline --lumen " + d + "/intact.obj --out " + d + "/intact/centerline.vtp");
+  ASSERT_EQ(r.code, 0) << r.out;
+  // A vertex in the middle of the vessel.
+  std::size_t mid = 0;
+  const Eigen::Vector3d centre = (lumen.points.front() + lumen.points.back()) / 2;
+  for (std::size_t i = 0; i < lumen.points.size(); ++i)
+    if ((lumen.points[i] - centre).norm() < (lumen.points[mid] - centre).norm()) mid = i;
+  auto flipped = lumen, wrong_index = lumen, shifted = lumen;
+  flipped.points[mid].x() = -flipped.points[mid].x();
+  wrong_index.triangles[wrong_index.triangles.size() / 2][0] = 0;
+  shifted.points[mid] += Eigen::Vector3d(3.0, -2.0, 1.0);
+  write_obj("flipped.obj", flipped);
+  write_obj("wrong_index.obj", wrong_index);
+  write_obj("shifted.obj", shifted);
+  // The sign flip and the wrong index fold the surface through itself.
+  for (const char* name : {"flipped", "wrong_index"}) {
+    r = sh("centerline --lumen " + d + "/" + name + ".obj --out " + d + "/" + name + "/centerline.vtp");
+    EXPECT_EQ(r.code, 2) << name << ": " << r.out;
+    EXPECT_NE(r.out.find(std::string(name) + ".obj: the surface intersects itself"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir / name / "centerline.vtp")) << name;
+  }
+  // The shifted vertex makes a spike out of the lumen that folds nothing: a valid surface, whose
+  // centerline and lesion stay those of the intact vessel (the inscribed spheres do not enter a
+  // spike), not a "stenosis" of the damage.
+  r = sh("centerline --lumen " + d + "/shifted.obj --out " + d + "/shifted/centerline.vtp");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto intact = stentsim::Summary::read(dir / "intact/summary.yaml"), spiked = stentsim::Summary::read(dir / "shifted/summary.yaml");
+  for (const char* key : {"lesion_1_min_radius", "lesion_1_percent_diameter", "centerline_length"}) {
+    const double a = std::get<double>(intact.qois().at(key).value), b = std::get<double>(spiked.qois().at(key).value);
+    EXPECT_NEAR(b, a, 0.01 * a) << key;
+  }
 }
 
 TEST_F(Cli, SolveRunsASceneAndRejectsBadOnes) {

@@ -28,7 +28,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", stentsim::describe_unexpected(e).c_str());
+    return 1;
+  } catch (...) {
+    std::fprintf(stderr, "error: %s\n", stentsim::describe_unknown().c_str());
     return 1;
   }
 }
