@@ -32,6 +32,7 @@ inline std::string describe_unexpected(const std::exception& e) {
   if (dynamic_cast<const std::bad_alloc*>(&e))
     return "out of memory: this input needs more memory than the process could get (a mesh, an image or a count far larger "
            "than expected? check the sizes in the input, or run on a machine with more memory)";
+  // stentsim's own errors (a ComputeError reaches the callers' std::exception handler) are worded already.
   if (dynamic_cast<const InputError*>(&e) || dynamic_cast<const ComputeError*>(&e)) return e.what();
   return std::string("internal error (please report it with the input that caused it): ") + e.what();
 }

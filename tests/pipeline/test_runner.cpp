@@ -200,7 +200,9 @@ TEST_F(RunnerTest, FailedStageKeepsItsPartialOutputsForTheUser) {
   config["b"] = "q=2 halfway";
   auto rep = run();
   EXPECT_EQ(rep.failed, (std::vector<std::string>{"b"}));
-  EXPECT_EQ(rep.first_failure_kind, ErrorKind::compute);  // a ComputeError
+  EXPECT_EQ(rep.first_failure_kind, ErrorKind::compute);  // a ComputeError, its own words passed on
+  EXPECT_NE(rep.first_failure.find("deliberate failure of b halfway"), std::string::npos) << rep.first_failure;
+  EXPECT_EQ(rep.first_failure.find("internal error"), std::string::npos) << rep.first_failure;
   EXPECT_EQ(Manifest::load(work / "manifest.yaml").find("b")->error_kind, ErrorKind::compute);
   EXPECT_EQ(last_output.find("bad input"), std::string::npos) << last_output;
   EXPECT_EQ(files::read_text(work / "b/out.txt"), before);  // the earlier artifact is untouched

@@ -344,6 +344,18 @@ TEST(LabelImage, MetaImageTransformMatrixRotatesAndMirrors) {
   fs::remove_all(dir);
 }
 
+/// The InputError that reading label 1 of `f` ends in, or "no error".
+std::string label_error_of(const fs::path& f) {
+  LabelSurfaceOptions o;
+  o.labels = {1};
+  try {
+    label_image_surface(f, o);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 // A detached voxel file (MetaImage ElementDataFile, NRRD "data file:") that is a
 // device or a pipe is refused before VTK opens it: reading /dev/zero would never
 // end and a FIFO would block. A missing one is named too.
@@ -352,16 +364,6 @@ TEST(LabelImage, DetachedDataFileThatIsADeviceOrAPipeIsRefused) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
-  auto error_of = [](const fs::path& f) -> std::string {
-    LabelSurfaceOptions o;
-    o.labels = {1};
-    try {
-      label_image_surface(f, o);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "no error";
-  };
   auto mhd = [&](const std::string& name, const std::string& data) {
     std::ofstream f(dir / name);
     f << "ObjectType = Image\nNDims = 3\nDimSize = " << kDim[0] << " " << kDim[1] << " " << kDim[2]
@@ -380,10 +382,10 @@ TEST(LabelImage, DetachedDataFileThatIsADeviceOrAPipeIsRefused) {
            {mhd("pipe.mhd", "pipe"), "ElementDataFile", "pipe"},
            {nhdr("zero.nhdr", "/dev/zero"), "data file", "/dev/zero"},
            {nhdr("pipe.nhdr", "pipe"), "data file", "pipe"}}) {
-    const std::string e = error_of(file);
+    const std::string e = label_error_of(file);
     EXPECT_NE(e.find(file.string() + ": " + key + " " + data + " is not a regular file"), std::string::npos) << e;
   }
-  const std::string e = error_of(mhd("missing.mhd", "nothing.raw"));
+  const std::string e = label_error_of(mhd("missing.mhd", "nothing.raw"));
   EXPECT_NE(e.find("ElementDataFile nothing.raw is missing"), std::string::npos) << e;
   fs::remove_all(dir);
 }
@@ -396,16 +398,6 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
   const double zero[3] = {0, 0, 0};
   auto im = cylinder(zero);
   const std::streamsize voxels = std::streamsize(kDim[0]) * kDim[1] * kDim[2];
-  auto error_of = [](const fs::path& f) -> std::string {
-    LabelSurfaceOptions o;
-    o.labels = {1};
-    try {
-      label_image_surface(f, o);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "no error";
-  };
   auto cut = [](const fs::path& f, std::uintmax_t keep) { fs::resize_file(f, keep); };
   // NIfTI (uncompressed and gzip), written by VTK, then cut in the voxel data.
   for (const char* name : {"labels.nii", "labels.nii.gz"}) {
@@ -414,7 +406,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
     w->SetFileName((dir / name).c_str());
     w->Write();
     cut(dir / name, fs::file_size(dir / name) / 2);
-    const std::string e = error_of(dir / name);
+    const std::string e = label_error_of(dir / name);
     EXPECT_NE(e.find(name), std::string::npos) << e;
     EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
   }
@@ -425,7 +417,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
       << "\nspacings: " << kSp[0] << " " << kSp[1] << " " << kSp[2] << "\nencoding: raw\n\n";
     f.write(static_cast<const char*>(im->GetScalarPointer()), voxels / 2);
   }
-  std::string e = error_of(dir / "labels.nrrd");
+  std::string e = label_error_of(dir / "labels.nrrd");
   EXPECT_NE(e.find("labels.nrrd"), std::string::npos) << e;
   EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
   {
@@ -436,7 +428,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
     w->Write();
   }
   cut(dir / "labels.mha", fs::file_size(dir / "labels.mha") - std::uintmax_t(voxels / 2));
-  e = error_of(dir / "labels.mha");
+  e = label_error_of(dir / "labels.mha");
   EXPECT_NE(e.find("labels.mha"), std::string::npos) << e;
   EXPECT_NE(e.find("cut short or damaged"), std::string::npos) << e;
   // A zero spacing in the header.
@@ -446,7 +438,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
       << "\nspacings: " << kSp[0] << " 0 " << kSp[2] << "\nencoding: raw\n\n";
     f.write(static_cast<const char*>(im->GetScalarPointer()), voxels);
   }
-  e = error_of(dir / "flat.nrrd");
+  e = label_error_of(dir / "flat.nrrd");
   EXPECT_NE(e.find("axis 2 has zero spacing"), std::string::npos) << e;
   // ... in a MetaImage header (ElementSpacing) and in a NIfTI one (pixdim[3], the z axis).
   {
@@ -455,7 +447,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
       << "\nElementSpacing = " << kSp[0] << " 0 " << kSp[2] << "\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n";
     f.write(static_cast<const char*>(im->GetScalarPointer()), voxels);
   }
-  e = error_of(dir / "flat.mha");
+  e = label_error_of(dir / "flat.mha");
   EXPECT_NE(e.find("flat.mha"), std::string::npos) << e;
   EXPECT_NE(e.find("ElementSpacing = '0.1 0 0.15'"), std::string::npos) << e;
   EXPECT_NE(e.find("non-zero"), std::string::npos) << e;
@@ -472,7 +464,7 @@ TEST(LabelImage, TruncatedFilesAndZeroSpacingAreNamed) {
     f.seekp(76 + 3 * 4);
     f.write(reinterpret_cast<const char*>(&zero_spacing), 4);
   }
-  e = error_of(dir / "flat.nii");
+  e = label_error_of(dir / "flat.nii");
   EXPECT_NE(e.find("flat.nii"), std::string::npos) << e;
   EXPECT_NE(e.find("pixdim[3] is 0: axis 3 has zero spacing"), std::string::npos) << e;
   fs::remove_all(dir);
@@ -486,16 +478,6 @@ TEST(LabelImage, DamagedHeadersAreInputErrorsNotCrashes) {
   const double zero[3] = {0, 0, 0};
   auto im = cylinder(zero);
   const std::string voxels(static_cast<const char*>(im->GetScalarPointer()), std::size_t(kDim[0]) * kDim[1] * kDim[2]);
-  auto error_of = [](const fs::path& f) -> std::string {
-    LabelSurfaceOptions o;
-    o.labels = {1};
-    try {
-      label_image_surface(f, o);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "no error";
-  };
   auto write = [](const fs::path& f, const std::string& bytes) { std::ofstream(f, std::ios::binary) << bytes; };
   auto slurp = [](const fs::path& f) {
     std::ifstream in(f, std::ios::binary);
@@ -511,24 +493,24 @@ TEST(LabelImage, DamagedHeadersAreInputErrorsNotCrashes) {
     std::string nii = slurp(dir / "good.nii");
     write(dir / "shifted.nii", nii.insert(71, std::string(11, '\xfc')));
   }
-  std::string e = error_of(dir / "shifted.nii");
+  std::string e = label_error_of(dir / "shifted.nii");
   EXPECT_NE(e.find("shifted.nii: NIfTI magic is not 'n+1'"), std::string::npos) << e;
   // NRRD without a dimension (segfault reading the voxels) and with a NUL in its header
   // (VTK loses the data offset: the read never ended).
   const std::string nrrd_tail = "sizes: " + std::to_string(kDim[0]) + " " + std::to_string(kDim[1]) + " " +
                                 std::to_string(kDim[2]) + "\nspacings: 0.1 0.1 0.1\nencoding: raw\n";
   write(dir / "nodim.nrrd", "NRRD0004\ntype: uint8\n" + nrrd_tail + "\n" + voxels);
-  e = error_of(dir / "nodim.nrrd");
+  e = label_error_of(dir / "nodim.nrrd");
   EXPECT_NE(e.find("nodim.nrrd: NRRD field 'sizes' comes before 'dimension: 3'"), std::string::npos) << e;
   write(dir / "nul.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nkind: domain" + std::string(1, '\0') + "domain\n" + nrrd_tail +
                               "\n" + voxels);
-  e = error_of(dir / "nul.nrrd");
+  e = label_error_of(dir / "nul.nrrd");
   EXPECT_NE(e.find("nul.nrrd: the NRRD header holds a NUL byte"), std::string::npos) << e;
   // MetaImage with NDims = 2^32 - 1 (MetaIO never returned).
   const std::string mha_tail = "\nDimSize = " + std::to_string(kDim[0]) + " " + std::to_string(kDim[1]) + " " +
                                std::to_string(kDim[2]) + "\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n" + voxels;
   write(dir / "ndims.mha", "ObjectType = Image\nNDims = 4294967295\nElementSpacing = 0.1 0.1 0.1" + mha_tail);
-  e = error_of(dir / "ndims.mha");
+  e = label_error_of(dir / "ndims.mha");
   EXPECT_NE(e.find("ndims.mha: MetaImage NDims = '4294967295' -- expected 3"), std::string::npos) << e;
   // A spacing so large along one axis that the end cuts leave nothing (segfault on the
   // empty piece list); the header itself is valid. A 14 x 14 x 30 cylinder, as the fuzz seed.
@@ -538,7 +520,7 @@ TEST(LabelImage, DamagedHeadersAreInputErrorsNotCrashes) {
       for (int i = 0; i < 14; ++i) small[std::size_t(i + 14 * (j + 14 * k))] = std::hypot(i - 6.5, j - 6.5) < 3.5 ? 1 : 0;
   write(dir / "wide.mha", "ObjectType = Image\nNDims = 3\nElementSpacing = 4294967295.5 0.5 0.5\nDimSize = 14 14 30\n"
                           "ElementType = MET_UCHAR\nElementDataFile = LOCAL\n" + small);
-  e = error_of(dir / "wide.mha");
+  e = label_error_of(dir / "wide.mha");
   EXPECT_NE(e.find("wide.mha: nothing of the labelled region is left between the two end cuts"), std::string::npos) << e;
   fs::remove_all(dir);
 }

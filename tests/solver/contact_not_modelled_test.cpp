@@ -20,6 +20,7 @@
 #include "solver/io/generated_meshes.hpp"
 #include "solver/terms/solid_body.hpp"
 #include "tests/solver/beam_test_bodies.hpp"
+#include "tests/solver/neo_hooke_block.hpp"
 
 namespace stentsim::solver {
 namespace {
@@ -85,24 +86,17 @@ TEST(ContactNotModelled, StrutsCloserThanTwoRadiiAreWarnedAboutWithTheirDepth) {
   EXPECT_LE(qoi(s, "strut_overlap_depth_max_stent"), 2 * R);
 }
 
-// A 2 x 2 x 0.2 mm slab (all its boundary faces, quad4, as a contact
-// surface); the top face's middle node pushed 0.1 mm below the bottom face.
+// A 2 x 2 x 0.2 mm neo-Hooke slab (all its boundary faces, quad4, as the contact
+// surface of a body called balloon); the top face's middle node pushed 0.1 mm
+// below the bottom face.
 TEST(ContactNotModelled, ASurfaceFoldedThroughItselfIsWarnedAboutWithItsFirstTime) {
-  SolidBodySpec spec;
-  spec.name = "balloon";
-  spec.mesh = box_hex8(4, 4, 1, 2.0, 2.0, 0.2);
-  Material mat;
-  mat.name = "nh";
-  mat.matrix = CoupledNeoHooke::from_young_poisson(1.0, 0.3);
-  spec.materials = {mat};
-  spec.cell_material.assign(spec.mesh.num_cells(), 0);
-  Model model;
-  const GlobalDof first = model.dofs.allocate("balloon", 3 * static_cast<GlobalDof>(spec.mesh.points.size()));
-  auto& body = model.add_term<SolidBody>(spec, first);
+  const auto block = make_neo_hooke_block(box_hex8(4, 4, 1, 2.0, 2.0, 0.2));
+  const SolidBody& body = *block->body;
+  const MeshData& mesh = body.mesh();
   const contact::ContactSurface surface("surface", body, fem::boundary_faces(body.mesh()));
   auto check = make_surface_self_intersection_check(surface, "balloon");
 
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.dofs.size()));
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(block->model.dofs.size()));
   const std::string quiet = logged("fold0", [&] {
     check->start(u, false);
     check->step(at_time(0.5), u);
@@ -114,8 +108,8 @@ TEST(ContactNotModelled, ASurfaceFoldedThroughItselfIsWarnedAboutWithItsFirstTim
   EXPECT_EQ(qoi(none, "self_intersection_first_time_balloon"), -1.0);
 
   std::size_t middle = 0;
-  for (std::size_t i = 0; i < spec.mesh.points.size(); ++i)
-    if ((spec.mesh.points[i] - Vec3(1.0, 1.0, 0.2)).norm() < 1e-9) middle = i;
+  for (std::size_t i = 0; i < mesh.points.size(); ++i)
+    if ((mesh.points[i] - Vec3(1.0, 1.0, 0.2)).norm() < 1e-9) middle = i;
   u[body.dof(middle, 2)] = -0.3;  // z: 0.2 -> -0.1, through the bottom face z = 0
   const std::string warned = logged("fold1", [&] { check->step(at_time(0.75), u); });
   EXPECT_NE(warned.find("body 'balloon': its contact surface intersects itself at t = 0.75"), std::string::npos) << warned;

@@ -46,6 +46,14 @@ std::filesystem::path edited(const std::filesystem::path& scene, const std::file
   return dir / "scene.yaml";
 }
 
+/// Solves `scene` into dir/out and returns its summary.
+Summary solved(const std::filesystem::path& scene, const std::filesystem::path& dir) {
+  SolveOptions o;
+  o.output_dir = dir / "out";
+  EXPECT_EQ(solve_scene(scene, o), 0);
+  return Summary::read(dir / "out/summary.yaml");
+}
+
 /// The last row of history.csv as column -> value.
 std::map<std::string, double> last_history_row(const std::filesystem::path& file) {
   std::istringstream in(files::read_text(file));
@@ -74,10 +82,7 @@ TEST(ContactOutputs, BeamLineLoadGapAndForceAgreeAcrossVtuHistoryAndSummary) {
   const auto dir = fresh_dir("beam");
   const auto scene = edited(kExamples / "studies/stability/strut_off_edge.yaml", dir,
                             {{"end: 3,", "end: 1,"}, {"every: 5", "every: 1"}});
-  SolveOptions o;
-  o.output_dir = dir / "out";
-  ASSERT_EQ(solve_scene(scene, o), 0);
-  const Summary s = Summary::read(dir / "out/summary.yaml");
+  const Summary s = solved(scene, dir);
   const double q_max = qoi(s, "contact_line_load_max_strut_block"), force = qoi(s, "contact_force_strut_block");
   const double eps = 10.0, R = 0.06;
 
@@ -130,10 +135,7 @@ TEST(ContactOutputs, SlavePressureAndForceAgreeAcrossVtuHistoryAndSummary) {
   for (std::string::size_type at; (at = text.find("file: data/")) != std::string::npos;)
     text.replace(at, 11, "file: " + (kExamples / "data").string() + "/");
   files::write_atomic(dir / "scene.yaml", text);
-  SolveOptions o;
-  o.output_dir = dir / "out";
-  ASSERT_EQ(solve_scene(dir / "scene.yaml", o), 0);
-  const Summary s = Summary::read(dir / "out/summary.yaml");
+  const Summary s = solved(dir / "scene.yaml", dir);
   const double p_max = qoi(s, "contact_pressure_max_interface"), force = qoi(s, "contact_force_interface");
   const auto row = last_history_row(dir / "out/history.csv");
   ASSERT_TRUE(row.count("contact_interface_force"));
