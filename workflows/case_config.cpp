@@ -105,10 +105,10 @@ SimulationSettings parse_simulation(ConfigMap m) {
                                          "phase / min_load_steps (0: it never grows)", s.load_steps));
   s.linear_solver = solver::read_linear_solver(m, "linear_solver", s.linear_solver);
   s.ranks = m.integer("ranks", s.ranks, Range::between(1, 4096));
-  if (s.ranks > 1 && s.linear_solver == solver::LinearSolverType::gmres_amg_block)
-    m.fail("ranks", fmt::format("linear_solver gmres_amg_block runs on one MPI rank in this version; set ranks: 1, or "
+  if (s.ranks > 1 && solver::one_rank_only(s.linear_solver))
+    m.fail("ranks", fmt::format("linear_solver {} runs on one MPI rank in this version; set ranks: 1, or "
                                 "linear_solver gmres_ilu (direct: the whole system's LU, far more memory) for {} ranks",
-                                s.ranks));
+                                solver::linear_solver_name(s.linear_solver), s.ranks));
   s.balloon_end_springs = m.quantity("balloon_end_springs", units::kStiffnessPerArea, s.balloon_end_springs, Range::positive());
   s.cut_springs = m.quantity("cut_springs", units::kStiffnessPerArea, s.cut_springs, Range::positive());
   s.beam_penalty = m.quantity("beam_penalty", units::kPressure, s.beam_penalty, Range::positive());

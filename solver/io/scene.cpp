@@ -401,7 +401,7 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   }
   if (li.has("preconditioner_update")) {
     if (scene.linear.type == LinearSolverType::direct || scene.linear.type == LinearSolverType::eigen_lu)
-      li.fail("preconditioner_update", "applies to the Krylov types (gmres_ilu, gmres_amg, gmres_amg_block) only");
+      li.fail("preconditioner_update", "applies to the Krylov types (gmres_ilu, gmres_amg, gmres_amg_block, gmres_lu) only");
     scene.linear.lag_preconditioner = li.choice("preconditioner_update", {"lagged", "every_solve"}, "lagged") == "lagged";
   }
   li.finish();

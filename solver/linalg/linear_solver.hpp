@@ -20,7 +20,13 @@ namespace stentsim::solver {
 /// gmres_amg_block: Belos GMRES + block Gauss-Seidel (block_split.hpp): MueLu
 /// SA-AMG on one solid body's unknowns (set_amg_block), UMFPACK LU on the
 /// rest (beams, a thin balloon: the unknowns AMG cannot aggregate). One rank.
-enum class LinearSolverType { direct, gmres_ilu, gmres_amg, eigen_lu, gmres_amg_block };
+/// gmres_lu: Belos GMRES preconditioned by a UMFPACK LU of the whole matrix,
+/// kept for later matrices while that pays (lag_preconditioner): a Newton
+/// iteration then costs a few triangular solves, not a factorization. One rank.
+enum class LinearSolverType { direct, gmres_ilu, gmres_amg, eigen_lu, gmres_amg_block, gmres_lu };
+
+/// True for the types that run on one MPI rank only (gmres_amg_block, gmres_lu, eigen_lu).
+bool one_rank_only(LinearSolverType type);
 
 /// The names every input accepts (scene, case, fibers stage, CLI), in enum order.
 const std::vector<std::string>& linear_solver_names();
@@ -97,7 +103,7 @@ std::unique_ptr<LinearSolver> make_eigen_lu_solver();
 /// while the pattern stays the same).
 std::unique_ptr<LinearSolver> make_umfpack_solver();
 /// direct (UMFPACK; on several ranks the matrix is gathered on rank 0),
-/// gmres_ilu, gmres_amg.
+/// gmres_ilu, gmres_amg, gmres_amg_block, gmres_lu.
 std::unique_ptr<LinearSolver> make_trilinos_solver(const LinearSolverSettings& settings);
 
 }  // namespace stentsim::solver

@@ -146,6 +146,32 @@ class BlockGaussSeidel : public OP {
   const UmfpackFactor& lu_;
 };
 
+// gmres_lu's preconditioner: the UMFPACK factors of the whole matrix (of this
+// solve's or, lagged, an earlier one's).
+class LuOperator : public OP {
+ public:
+  LuOperator(RCP<const Map> map, const UmfpackFactor& lu) : map_(std::move(map)), lu_(lu) {}
+  RCP<const Map> getDomainMap() const override { return map_; }
+  RCP<const Map> getRangeMap() const override { return map_; }
+  void apply(const MV& x, MV& y, Teuchos::ETransp mode = Teuchos::NO_TRANS, SC alpha = Teuchos::ScalarTraits<SC>::one(),
+             SC beta = Teuchos::ScalarTraits<SC>::zero()) const override {
+    if (mode != Teuchos::NO_TRANS) throw std::logic_error("gmres_lu: the preconditioner has no transpose");
+    const auto n = static_cast<Eigen::Index>(lu_.rows());
+    Eigen::VectorXd r(n), z;
+    for (std::size_t j = 0; j < x.getNumVectors(); ++j) {
+      const auto xd = x.getData(j);
+      for (Eigen::Index i = 0; i < n; ++i) r(i) = xd[i];
+      lu_.solve(r, z);
+      auto out = y.getDataNonConst(j);
+      for (Eigen::Index i = 0; i < n; ++i) out[i] = beta == 0.0 ? alpha * z(i) : alpha * z(i) + beta * out[i];
+    }
+  }
+
+ private:
+  RCP<const Map> map_;
+  const UmfpackFactor& lu_;
+};
+
 class TrilinosSolver : public LinearSolver {
  public:
   explicit TrilinosSolver(LinearSolverSettings s) : settings_(std::move(s)) {
@@ -171,6 +197,8 @@ class TrilinosSolver : public LinearSolver {
     else if (settings_.type == LinearSolverType::gmres_amg_block)
       o << "block Gauss-Seidel: MueLu smoothed-aggregation AMG on unknowns [" << block_begin_ << ", " << block_end_
         << "), UMFPACK LU on the others";
+    else if (settings_.type == LinearSolverType::gmres_lu)
+      o << "UMFPACK LU of the whole matrix" << (settings_.lag_preconditioner ? ", kept for later matrices while that pays" : "");
     else if (settings_.amg_equations_per_node == 1) o << "MueLu smoothed-aggregation AMG (scalar, constant near-null space, symmetric Gauss-Seidel)";
     else o << "MueLu smoothed-aggregation AMG (" << settings_.amg_equations_per_node << " equations per node, symmetric Gauss-Seidel)";
     if (settings_.type != LinearSolverType::gmres_ilu && !settings_.amg_parameters.empty())
@@ -182,8 +210,9 @@ class TrilinosSolver : public LinearSolver {
     // One rank: its contributions are the whole matrix, no Tpetra copy needed.
     if (settings_.type == LinearSolverType::direct && comm_->getSize() == 1) return direct_->solve(a, b, x);
     const bool block = settings_.type == LinearSolverType::gmres_amg_block;
-    if (block && comm_->getSize() > 1)
-      throw InputError("linear.type gmres_amg_block runs on one MPI rank in this version; on " +
+    const bool whole_lu = settings_.type == LinearSolverType::gmres_lu;
+    if (one_rank_only(settings_.type) && comm_->getSize() > 1)
+      throw InputError("linear.type " + linear_solver_name(settings_.type) + " runs on one MPI rank in this version; on " +
                        std::to_string(comm_->getSize()) + " ranks use direct or gmres_ilu");
     LinearSolveStats stats;
     const auto t0 = Clock::now();
@@ -232,17 +261,19 @@ class TrilinosSolver : public LinearSolver {
       return stats;
     }
     // A lagged preconditioner (lag_preconditioner, LagPolicy): AMG's hierarchy (with its
-    // smoothers and coarse operators) or ILU's factors as the last set-up left them.
-    // gmres_amg_block lags block 1's AMG only, which works on any matrix of the same size
-    // (its matrix is its own copy); gmres_amg's and gmres_ilu's are bound to the kept
-    // matrix, so they serve only a matrix of its pattern.
-    const bool lag = settings_.lag_preconditioner && keep && lag_.may_lag() && (block ? bool(block_amg_) : reuse && kept_prec_);
+    // smoothers and coarse operators), ILU's or LU's factors as the last set-up left them.
+    // gmres_amg_block lags block 1's AMG only and gmres_lu its factors, which work on any
+    // matrix of the same size (they hold their own copies); gmres_amg's and gmres_ilu's are
+    // bound to the kept matrix, so they serve only a matrix of its pattern.
+    const bool any_pattern = block || whole_lu;
+    const bool held = block ? bool(block_amg_) : whole_lu ? whole_lu_.rows() == a.rows && kept_prec_ : reuse && kept_prec_;
+    const bool lag = settings_.lag_preconditioner && keep && lag_.may_lag() && held;
     RCP<OP> prec;
     const auto tp = Clock::now();
     if (lag) {
-      prec = block ? block_preconditioner(a, map, stats, false) : kept_prec_;
+      prec = block ? block_preconditioner(a, map, stats, false) : whole_lu ? RCP<OP>(new LuOperator(map, whole_lu_)) : kept_prec_;
       stats.preconditioner_lagged = true;
-      if (block && !reuse) kept_.keep(mat, a);
+      if (any_pattern && !reuse) kept_.keep(mat, a);
     } else {
       prec = fresh_preconditioner(a, mat, map, reuse, keep, stats);
     }
@@ -329,6 +360,14 @@ class TrilinosSolver : public LinearSolver {
       RCP<OP> prec = block_preconditioner(a, map, stats, true);
       if (!reuse) kept_.keep(mat, a);
       return prec;
+    }
+    if (settings_.type == LinearSolverType::gmres_lu) {
+      kept_prec_ = Teuchos::null;  // a failed factorization leaves nothing to lag
+      whole_lu_.factor(a);         // its symbolic analysis kept while the pattern stays
+      stats.preconditioner_built = true;
+      kept_prec_ = rcp(new LuOperator(map, whole_lu_));
+      if (!reuse) kept_.keep(mat, a);
+      return kept_prec_;
     }
     if (reuse) {
       if (auto ilu = Teuchos::rcp_dynamic_cast<Ifpack2::Preconditioner<SC, LO, GO, NO>>(kept_prec_)) {
@@ -593,6 +632,7 @@ class TrilinosSolver : public LinearSolver {
   RCP<const Map> block_map_;  // block 1's map (its AMG's)
   double block_amg_seconds_ = 0.0;  // the last set-up of block 1's AMG
   UmfpackFactor block_lu_{false};  // no iterative refinement: GMRES corrects the block solve
+  UmfpackFactor whole_lu_{false};  // gmres_lu's factors (likewise unrefined)
   Eigen::MatrixXd modes_;
   Eigen::MatrixXd coordinates_;       // set_node_coordinates
   double requested_tolerance_ = 0.0;  // set_relative_tolerance

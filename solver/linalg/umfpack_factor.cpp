@@ -44,7 +44,7 @@ const char* ordering_name(double o) {
 
 static_assert(UMFPACK_CONTROL == 20 && UMFPACK_INFO == 90, "umfpack_factor.hpp sizes its arrays by UMFPACK's");
 
-UmfpackFactor::UmfpackFactor(bool refine) {
+UmfpackFactor::UmfpackFactor(bool refine) : refine_(refine) {
   umfpack_dl_defaults(control_);
   if (!refine) control_[UMFPACK_IRSTEP] = 0;
   // Orders A + A' by AMD and METIS and keeps the one with less fill: the
@@ -63,7 +63,8 @@ void UmfpackFactor::release() {
 void UmfpackFactor::factor(const CsrMatrix& a) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  a_ = &a;
+  a_ = refine_ ? &a : nullptr;
+  rows_ = a.rows;
   if (a.rows == 0) return;
   const SuiteSparse_long n = a.rows;
   const auto* ap = reinterpret_cast<const SuiteSparse_long*>(a.row_ptr.data());
@@ -93,10 +94,12 @@ void UmfpackFactor::factor(const CsrMatrix& a) {
 
 void UmfpackFactor::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
   x.resize(b.size());
-  if (!a_ || a_->rows == 0) return;
-  const auto* ap = reinterpret_cast<const SuiteSparse_long*>(a_->row_ptr.data());
-  const auto* ai = reinterpret_cast<const SuiteSparse_long*>(a_->cols.data());
-  const SuiteSparse_long ss = umfpack_dl_solve(UMFPACK_At, ap, ai, a_->values.data(), x.data(), b.data(), numeric_, control_, info_);
+  if (rows_ == 0) return;
+  // Without refinement UMFPACK does not read A (umfpack_solve.h: the arrays may then be NULL).
+  const auto* ap = a_ ? reinterpret_cast<const SuiteSparse_long*>(a_->row_ptr.data()) : nullptr;
+  const auto* ai = a_ ? reinterpret_cast<const SuiteSparse_long*>(a_->cols.data()) : nullptr;
+  const double* ax = a_ ? a_->values.data() : nullptr;
+  const SuiteSparse_long ss = umfpack_dl_solve(UMFPACK_At, ap, ai, ax, x.data(), b.data(), numeric_, control_, info_);
   if (ss != UMFPACK_OK) throw std::runtime_error("UMFPACK solve failed: " + umfpack_status_text(ss));
 }
 

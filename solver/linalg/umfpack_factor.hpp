@@ -27,16 +27,20 @@ class UmfpackFactor {
   UmfpackFactor(const UmfpackFactor&) = delete;
   UmfpackFactor& operator=(const UmfpackFactor&) = delete;
 
-  /// Factorizes `a` (kept by reference: it must outlive the solves). Throws
+  /// Factorizes `a`. With refinement `a` is kept by reference and must
+  /// outlive the solves; without, the solves read the factors only, so `a` may
+  /// change or go (a preconditioner kept for later matrices). Throws
   /// std::runtime_error naming UMFPACK's reason when it cannot.
   void factor(const CsrMatrix& a);
   /// x = A⁻¹ b with the last factorization.
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
-  std::int64_t rows() const { return a_ ? a_->rows : 0; }
+  std::int64_t rows() const { return rows_; }
 
  private:
   void release();
-  const CsrMatrix* a_ = nullptr;
+  bool refine_ = true;
+  std::int64_t rows_ = 0;
+  const CsrMatrix* a_ = nullptr;  // for the refinement only
   double control_[20]{};      // UMFPACK_CONTROL
   mutable double info_[90]{};  // UMFPACK_INFO
   void* symbolic_ = nullptr;

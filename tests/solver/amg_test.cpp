@@ -199,14 +199,15 @@ TEST(SolverAmg, ScenesChooseIt) {
 }
 
 // gmres_amg_block on a beam + solid contact scene (AMG on the balloon, LU on the
-// ring): the direct solver's QoIs, through contact coming in and out of reach (the
-// kept hierarchy meets newly filled contact entries there).
+// ring) and gmres_lu (the whole matrix's LU, lagged): the direct solver's QoIs,
+// through contact coming in and out of reach (the kept hierarchy and the kept
+// factors meet newly filled contact entries there).
 TEST(SolverAmg, BlockPreconditionerOnBeamContactSceneMatchesDirect) {
   const std::filesystem::path examples = std::filesystem::path(STENTSIM_TEST_SOURCE_DIR) / "examples";
   const auto out = std::filesystem::temp_directory_path() / ("stentsim_amg_block_" + std::to_string(::getpid()));
-  std::map<std::string, double> q[2];
+  std::map<std::string, double> q[3];
   int k = 0;
-  for (const char* type : {"direct", "gmres_amg_block"}) {
+  for (const char* type : {"direct", "gmres_amg_block", "gmres_lu"}) {
     SolveOptions o;
     o.output_dir = out / type;
     o.linear_solver = parse_linear_solver(type, "test");
@@ -215,7 +216,8 @@ TEST(SolverAmg, BlockPreconditionerOnBeamContactSceneMatchesDirect) {
       q[k][name] = std::get<double>(Summary::read(out / type / "summary.yaml").qois().at(name).value);
     ++k;
   }
-  for (const auto& [name, v] : q[0]) EXPECT_NEAR(q[1][name], v, 1e-7 * std::abs(v)) << name;
+  for (int j : {1, 2})
+    for (const auto& [name, v] : q[0]) EXPECT_NEAR(q[j][name], v, 1e-7 * std::abs(v)) << name << " with solver " << j;
   EXPECT_GT(q[0]["contact_force_stent_balloon_max"], 1.0);  // the ring was pushed by contact
   // A scene with one solid body and nothing else has no second block.
   SolveOptions o;

@@ -309,3 +309,50 @@ TEST(LaggedPreconditioner, LaggedSolvesReachTheToleranceAndAFailedOneIsRepeatedF
     EXPECT_GE(lagged, 1);
   }
 }
+
+// gmres_lu: the first solve factors the whole matrix (one GMRES iteration to the
+// tolerance); the next matrices, of other values and of a grown pattern alike, are
+// solved with those factors (lagged) in a few iterations, each to the tolerance on
+// its own matrix; a matrix they no longer serve within max_iterations (the
+// anisotropy turned 50:1) is solved with fresh factors. With every_solve each
+// solve factors its own matrix.
+TEST(LaggedPreconditioner, WholeMatrixLuServesLaterMatricesToTheTolerance) {
+  LinearSolverSettings s;
+  s.type = LinearSolverType::gmres_lu;
+  s.tolerance = 1e-10;
+  s.max_iterations = 12;
+  const auto solver = make_linear_solver(s);
+  EXPECT_NE(solver->describe().find("UMFPACK LU of the whole matrix"), std::string::npos) << solver->describe();
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3375, -1, 2);
+  struct Case { double skew; bool grown; double wz; };
+  const std::vector<Case> cases{{0.0, false, 1}, {0.02, false, 1}, {0.04, true, 1}, {0.06, true, 1}, {0.1, true, 50}};
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const CsrMatrix a = grid_matrix(15, cases[k].skew, cases[k].grown, 1.0, cases[k].wz);
+    Eigen::VectorXd x;
+    const auto st = solver->solve(a, b, x);
+    std::printf("gmres_lu, matrix %zu: %d GMRES iterations%s%s\n", k, st.iterations, st.preconditioner_lagged ? " (lagged)" : "",
+                st.preconditioner_built ? " (built)" : "");
+    ASSERT_TRUE(st.converged) << "matrix " << k;
+    EXPECT_LT((a.multiply(x) - b).norm() / b.norm(), 1e-9) << "matrix " << k;
+    if (k == 0) {
+      EXPECT_TRUE(st.preconditioner_built);
+      EXPECT_LE(st.iterations, 2) << "GMRES on the matrix's own LU";
+    } else if (k + 1 < cases.size()) {
+      EXPECT_TRUE(st.preconditioner_lagged) << "matrix " << k << " (pattern grown: " << cases[k].grown << ")";
+      EXPECT_FALSE(st.preconditioner_built) << "matrix " << k;
+      EXPECT_GE(st.iterations, 2) << "an earlier matrix's factors are not this one's";
+    } else {
+      EXPECT_FALSE(st.preconditioner_lagged) << "the turned matrix is solved with fresh factors";
+      EXPECT_TRUE(st.preconditioner_built);
+      EXPECT_GT(st.iterations, s.max_iterations / 2) << "its count includes the lagged attempt";
+    }
+  }
+  s.lag_preconditioner = false;
+  const auto every = make_linear_solver(s);
+  for (double skew : {0.0, 0.02}) {
+    Eigen::VectorXd x;
+    const auto st = every->solve(grid_matrix(15, skew), b, x);
+    EXPECT_TRUE(st.converged && st.preconditioner_built && !st.preconditioner_lagged) << "skew " << skew;
+    EXPECT_LE(st.iterations, 2) << "skew " << skew;
+  }
+}
