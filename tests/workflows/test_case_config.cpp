@@ -80,6 +80,8 @@ TEST(CaseConfig, BadFilesGiveErrorsThatNameFileLineKeyAndExpectation) {
   msg = load_error("scene: patient\n" + in + "simulation:\n  linear_solver: gmres_amg_block\n  ranks: 2\n");
   EXPECT_NE(msg.find("bad.yaml:5:10: simulation.ranks"), std::string::npos) << msg;
   EXPECT_NE(msg.find("gmres_amg_block runs on one MPI rank"), std::string::npos) << msg;
+  msg = load_error("scene: patient\n" + in + "simulation:\n  linear_solver: gmres_lu\n  ranks: 2\n");
+  EXPECT_NE(msg.find("gmres_lu runs on one MPI rank"), std::string::npos) << msg;
   EXPECT_EQ(load_error("scene: patient\n" + in + "simulation:\n  linear_solver: gmres_ilu\n  ranks: 2\n"), "");
   msg = load_error("scene: patient\nsimulation:\n  load_steps: 4\n  min_load_steps: 5\n");
   EXPECT_NE(msg.find("simulation.min_load_steps"), std::string::npos) << msg;
