@@ -183,6 +183,24 @@ TriSurface load_checked_surface(const std::filesystem::path& file, const Surface
   return check_and_repair(std::move(raw), checks, file.string(), report);
 }
 
+TriSurface load_stage_surface(const std::filesystem::path& file, const std::string& tool) {
+  if (file.extension() != ".vtp")  // the stages read VTP only
+    throw InputError(fmt::format("{}: {} reads VTP surfaces (.vtp); `stentsim segmentation` writes one from a .vtp, .vtk, "
+                                 ".stl or .obj (a case file's input.surface.lumen or .wall)", file.string(), tool));
+  SurfaceCheckOptions checks;
+  checks.repair = false;
+  checks.repair_off_note = tool + " does not repair surfaces";
+  checks.units_key = "input.surface.units";
+  SurfaceReport report;
+  try {
+    return load_checked_surface(file, checks, report);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}\n{} takes surfaces in mm as `stentsim segmentation` writes them: run that on this "
+                                 "file (a case file's input.surface.lumen or .wall, with its units) to check, scale and "
+                                 "repair it", e.what(), tool));
+  }
+}
+
 void report_to_summary(const std::string& prefix, const SurfaceReport& r, Summary& s) {
   s.set(prefix + "_merged_points", r.merged_points);
   s.set(prefix + "_degenerate_triangles_removed", r.degenerate_triangles);

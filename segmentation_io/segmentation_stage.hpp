@@ -133,6 +133,18 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
 TriSurface load_checked_surface(const std::filesystem::path& file, const SurfaceCheckOptions& checks,
                                 SurfaceReport& report);
 
+/// A lumen or wall surface handed to a tool as a file (`stentsim mesh`, `stentsim
+/// place`): read by extension and given the surface checks in mm with repairs
+/// off, which the segmentation stage's outputs pass. The error names the file
+/// and says that `stentsim segmentation` (an input.surface section) scales and
+/// repairs such a surface; `tool` is the command, for that message.
+TriSurface load_stage_surface(const std::filesystem::path& file, const std::string& tool);
+
+/// InputError unless a sample of the lumen's points (its end rings aside) lies
+/// inside the wall capped at its ends; `wall_what` says which wall, for the message.
+void check_wall_encloses_lumen(const TriSurface& lumen, const TriSurface& wall, const std::string& lumen_name,
+                               const std::string& wall_what);
+
 /// The report's counts and repair notes as `<prefix>_...` QoIs and notes of `summary`.
 void report_to_summary(const std::string& prefix, const SurfaceReport& report, Summary& summary);
 

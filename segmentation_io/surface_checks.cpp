@@ -85,7 +85,7 @@ std::pair<int, int> edge_key(int a, int b) { return {std::min(a, b), std::max(a,
 TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& o, const std::string& what, SurfaceReport& rep) {
   auto fail = [&](const std::string& msg) { throw InputError(fmt::format("{}: {}", what, msg)); };
   auto repairable = [&](const std::string& msg) {
-    if (!o.repair) fail(msg + " (repair is off)");
+    if (!o.repair) fail(msg + " (" + o.repair_off_note + ")");
     rep.notes.push_back(msg);
     log::warn("{}: repaired: {}", what, msg);
   };
@@ -260,7 +260,7 @@ TriSurface check_and_repair(TriSurface s, const SurfaceCheckOptions& o, const st
     if (!all_small || !o.repair)
       fail(fmt::format("the surface has {} open boundaries but {} open ends were expected; the extra ones are holes "
                        "or further branches{}:{}", loops.size(), o.expected_open_ends,
-                       o.repair ? " too large to fill" : " (repair is off)", list));
+                       o.repair ? " too large to fill" : " (" + o.repair_off_note + ")", list));
     std::vector<BoundaryLoop> holes_only(loops.begin() + o.expected_open_ends, loops.end());
     s = capped(s, holes_only);
     rep.holes_filled = holes;

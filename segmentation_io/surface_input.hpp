@@ -41,6 +41,7 @@ struct SurfaceCheckOptions {
   std::string units = "mm";           // units of the file's coordinates
   std::string units_key = "units";    // the setting that gives them, for errors ("input.surface.units", "--units")
   bool repair = true;                  // false: every defect is an error
+  std::string repair_off_note = "repair is off";  // said beside a defect repair would mend, when it is off
   int expected_open_ends = 2;          // open tube ends (proximal and distal cuts); 0 for a closed surface
   double merge_tolerance = 1e-6;       // duplicate points closer than this × bounding-box diagonal are merged
   double small_piece_fraction = 0.01;  // repair drops pieces with less than this fraction of the area

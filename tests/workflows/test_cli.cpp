@@ -16,7 +16,9 @@
 
 #include "common/files.hpp"
 #include "common/summary.hpp"
+#include "common/mesh_data.hpp"
 #include "segmentation_io/surface_input.hpp"
+#include "segmentation_io/triangle_surface.hpp"
 #include "tests/workflows/cli_runner.hpp"
 
 namespace fs = std::filesystem;
@@ -259,6 +261,54 @@ TEST_F(Cli, StandAloneCenterlineRefusesACorruptedSurface) {
     const double a = std::get<double>(intact.qois().at(key).value), b = std::get<double>(spiked.qois().at(key).value);
     EXPECT_NEAR(b, a, 0.01 * a) << key;
   }
+}
+
+// `mesh` and `place` take lumen.vtp (and wall.vtp) as files and give them the case path's
+// surface checks, repairs off: a damaged, holed, mis-scaled or swapped surface is refused
+// (exit 2, the file named, what mends it said) before gmsh or the placement sees it, and
+// nothing is written. The intact phantom passes (the other mesh and place tests).
+TEST_F(Cli, StandAloneMeshAndPlaceRunTheSurfaceChecks) {
+  namespace seg = stentsim::segmentation;
+  const std::string d = dir.string();
+  auto r = sh("phantom --preset case2-rca --out " + d + "/ph");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const seg::TriSurface lumen = seg::read_surface_file(dir / "ph/lumen.vtp");
+  auto write = [&](const std::string& name, const seg::TriSurface& s) {
+    stentsim::write_vtp((dir / name).string(), seg::mesh_from_surface(s));
+    return d + "/" + name;
+  };
+  std::size_t mid = 0;  // a vertex in the middle of the vessel
+  const Eigen::Vector3d centre = (lumen.points.front() + lumen.points.back()) / 2;
+  for (std::size_t i = 0; i < lumen.points.size(); ++i)
+    if ((lumen.points[i] - centre).norm() < (lumen.points[mid] - centre).norm()) mid = i;
+  auto flipped = lumen, holed = lumen, in_um = lumen;
+  flipped.points[mid].x() = -flipped.points[mid].x();
+  holed.triangles.erase(holed.triangles.begin() + long(holed.triangles.size() / 2));
+  for (auto& p : in_um.points) p *= 1000.0;
+  const std::string wall = d + "/ph/wall.vtp", cl = d + "/ph/centerline_true.vtp";
+  fs::copy_file(dir / "ph/lumen.vtp", dir / "lumen.stl");
+  struct Bad {
+    std::string lumen, wall, says;
+  };
+  const std::vector<Bad> bad{
+      {write("flipped.vtp", flipped), wall, "flipped.vtp: the surface intersects itself"},
+      {write("holed.vtp", holed), wall, "(stentsim mesh does not repair surfaces)"},
+      {write("in_um.vtp", in_um), wall, "set input.surface.units: um"},
+      {d + "/lumen.stl", wall, "lumen.stl: stentsim mesh reads VTP surfaces"},
+      {wall, d + "/ph/lumen.vtp", "lie outside the wall " + d + "/ph/lumen.vtp"},
+      {d + "/ph/lumen.vtp", d + "/flipped.vtp", "flipped.vtp: the surface intersects itself"}};
+  for (const auto& b : bad) {
+    r = sh("mesh --lumen " + b.lumen + " --wall " + b.wall + " --centerline " + cl + " --out " + d + "/mesh");
+    EXPECT_EQ(r.code, 2) << b.lumen << ": " << r.out;
+    EXPECT_NE(r.out.find(b.says), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir / "mesh")) << b.lumen;
+  }
+  EXPECT_NE(r.out.find("stentsim mesh takes surfaces in mm as `stentsim segmentation` writes them"), std::string::npos) << r.out;
+  r = sh("place --centerline " + cl + " --lumen " + d + "/flipped.vtp --out " + d + "/pl");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("flipped.vtp: the surface intersects itself"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("stentsim place takes surfaces in mm"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "pl/placement.yaml"));
 }
 
 TEST_F(Cli, SolveRunsASceneAndRejectsBadOnes) {

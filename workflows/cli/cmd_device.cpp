@@ -8,6 +8,7 @@
 #include "common/config.hpp"
 #include "common/summary.hpp"
 #include "device_gen/stages.hpp"
+#include "segmentation_io/segmentation_stage.hpp"
 #include "workflows/cli/commands.hpp"
 
 namespace fs = std::filesystem;
@@ -57,7 +58,10 @@ void register_device(CLI::App& app) {
     const fs::path out(a->out);
     Summary s;
     std::optional<fs::path> lumen;
-    if (!a->lumen.empty()) lumen = a->lumen;
+    if (!a->lumen.empty()) {
+      (void)segmentation::load_stage_surface(a->lumen, "stentsim place");  // the case path's surface checks
+      lumen = a->lumen;
+    }
     device_gen::run_placement_stage(d.placement, a->centerline, lumen, d.balloon, d.stent, out / "placement.yaml",
                                     out / "balloon_centerline.vtp", s);
     write_summary(s, out / "placement.yaml");
