@@ -66,6 +66,9 @@ struct LinearSolveStats {
   bool preconditioner_built = false;
   /// The preconditioner of an earlier matrix served this solve unchanged (lag_preconditioner).
   bool preconditioner_lagged = false;
+  /// UMFPACK numeric factorizations made for this solve: 1 for direct and for a
+  /// gmres_lu or gmres_amg_block set-up (the whole matrix, block 2), 0 when lagged.
+  int lu_factorizations = 0;
 };
 
 class LinearSolver {

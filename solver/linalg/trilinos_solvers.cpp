@@ -103,6 +103,10 @@ struct KeptMatrix {
   }
 };
 
+// y = alpha * v + beta * y for one entry of an operator's output; beta = 0
+// overwrites y (which may hold garbage, Tpetra's convention).
+double scaled_output(double v, double y, SC alpha, SC beta) { return beta == 0.0 ? alpha * v : alpha * v + beta * y; }
+
 // gmres_amg_block's preconditioner (block_split.hpp): one forward block
 // Gauss-Seidel sweep, AMG on block 1 then the direct solve of block 2 (one rank).
 class BlockGaussSeidel : public OP {
@@ -132,8 +136,7 @@ class BlockGaussSeidel : public OP {
       r2 -= split_.a21.multiply(y1e);
       lu_.solve(r2, y2);
       auto out = y.getDataNonConst(j);
-      // beta = 0 overwrites y (which may hold garbage, Tpetra's convention).
-      auto put = [&](std::int64_t i, double v) { out[i] = beta == 0.0 ? alpha * v : alpha * v + beta * out[i]; };
+      auto put = [&](std::int64_t i, double v) { out[i] = scaled_output(v, out[i], alpha, beta); };
       for (std::int64_t i = 0; i < n1; ++i) put(split_.begin + i, y1e(i));
       for (std::int64_t k = 0; k < n2; ++k) put(split_.full_of_outer(k), y2(k));
     }
@@ -163,7 +166,7 @@ class LuOperator : public OP {
       for (Eigen::Index i = 0; i < n; ++i) r(i) = xd[i];
       lu_.solve(r, z);
       auto out = y.getDataNonConst(j);
-      for (Eigen::Index i = 0; i < n; ++i) out[i] = beta == 0.0 ? alpha * z(i) : alpha * z(i) + beta * out[i];
+      for (Eigen::Index i = 0; i < n; ++i) out[i] = scaled_output(z(i), out[i], alpha, beta);
     }
   }
 
@@ -211,9 +214,8 @@ class TrilinosSolver : public LinearSolver {
     if (settings_.type == LinearSolverType::direct && comm_->getSize() == 1) return direct_->solve(a, b, x);
     const bool block = settings_.type == LinearSolverType::gmres_amg_block;
     const bool whole_lu = settings_.type == LinearSolverType::gmres_lu;
-    if (one_rank_only(settings_.type) && comm_->getSize() > 1)
-      throw InputError("linear.type " + linear_solver_name(settings_.type) + " runs on one MPI rank in this version; on " +
-                       std::to_string(comm_->getSize()) + " ranks use direct or gmres_ilu");
+    if (one_rank_only(settings_.type) && comm_->getSize() > 1)  // solve() refuses such a scene first
+      throw std::logic_error("linear solver " + linear_solver_name(settings_.type) + " on " + std::to_string(comm_->getSize()) + " ranks");
     LinearSolveStats stats;
     const auto t0 = Clock::now();
     const GO n = static_cast<GO>(a.rows);
@@ -233,8 +235,9 @@ class TrilinosSolver : public LinearSolver {
     // counts stayed as after a fresh set-up over its 20 steps; a test bounds the
     // cost of a matrix whose anisotropy turns, test_solver_linear_reuse).
     //
-    // gmres_amg_block keeps the whole matrix likewise, and its blocks' AMG and LU
-    // while block 1's pattern stays (block_preconditioner).
+    // gmres_amg_block keeps the whole matrix likewise, block 1's AMG prolongators
+    // while block 1's pattern stays and block 2's LU analysis while block 2's does
+    // (block_preconditioner).
     const bool keep = settings_.type != LinearSolverType::direct && comm_->getSize() == 1;
     const bool reuse = keep && kept_.holds(a);
     RCP<const Map> map;
@@ -257,16 +260,20 @@ class TrilinosSolver : public LinearSolver {
       // test_solver_mpi_two_ranks): gather the assembled matrix on rank 0,
       // factor it there with UMFPACK and broadcast.
       stats = gathered_direct_solve(mat, map, b, x);
+      stats.lu_factorizations = 1;
       stats.setup_seconds = seconds(t0, Clock::now()) - stats.solve_seconds;  // matrix, gather, factorization, broadcast
       return stats;
     }
     // A lagged preconditioner (lag_preconditioner, LagPolicy): AMG's hierarchy (with its
     // smoothers and coarse operators), ILU's or LU's factors as the last set-up left them.
-    // gmres_amg_block lags block 1's AMG only and gmres_lu its factors, which work on any
-    // matrix of the same size (they hold their own copies); gmres_amg's and gmres_ilu's are
-    // bound to the kept matrix, so they serve only a matrix of its pattern.
+    // gmres_amg_block lags block 1's AMG and block 2's LU, gmres_lu its factors; these work on any
+    // matrix of the same size (AMG holds its own matrix, the LU solves read the factors
+    // only); gmres_amg's and gmres_ilu's are bound to the kept matrix, so they serve only a
+    // matrix of its pattern. A failed factorization leaves no factors to lag (rows() -1).
     const bool any_pattern = block || whole_lu;
-    const bool held = block ? bool(block_amg_) : whole_lu ? whole_lu_.rows() == a.rows && kept_prec_ : reuse && kept_prec_;
+    const bool held = block      ? block_amg_ && block_lu_.rows() == a.rows - (block_end_ - block_begin_)
+                      : whole_lu ? whole_lu_.rows() == a.rows && kept_prec_
+                                 : reuse && kept_prec_;
     const bool lag = settings_.lag_preconditioner && keep && lag_.may_lag() && held;
     RCP<OP> prec;
     const auto tp = Clock::now();
@@ -296,13 +303,13 @@ class TrilinosSolver : public LinearSolver {
       const GmresResult first = g;
       const double rest = first.achieved > tolerance ? tolerance / first.achieved : 1.0;
       g = gmres(mat, prec, xv, bv, settings_.max_iterations, rest);
-      lag_.built(block ? block_amg_seconds_ : seconds(t2, t3), g.iterations, g.achieved, seconds(t3, Clock::now()));
+      lag_.built(block ? block_amg_seconds_ + block_lu_seconds_ : seconds(t2, t3), g.iterations, g.achieved, seconds(t3, Clock::now()));
       g.iterations += first.iterations;
       g.achieved *= first.achieved;
       stats.setup_seconds += seconds(t2, t3);
       stats.solve_seconds += seconds(t3, Clock::now());
     } else if (!lag) {
-      lag_.built(block ? block_amg_seconds_ : seconds(tp, t1), g.iterations, g.achieved, stats.solve_seconds);
+      lag_.built(block ? block_amg_seconds_ + block_lu_seconds_ : seconds(tp, t1), g.iterations, g.achieved, stats.solve_seconds);
     } else {
       lag_.lagged(g.iterations, g.achieved, stats.solve_seconds);
     }
@@ -365,6 +372,7 @@ class TrilinosSolver : public LinearSolver {
       kept_prec_ = Teuchos::null;  // a failed factorization leaves nothing to lag
       whole_lu_.factor(a);         // its symbolic analysis kept while the pattern stays
       stats.preconditioner_built = true;
+      ++stats.lu_factorizations;
       kept_prec_ = rcp(new LuOperator(map, whole_lu_));
       if (!reuse) kept_.keep(mat, a);
       return kept_prec_;
@@ -462,9 +470,8 @@ class TrilinosSolver : public LinearSolver {
 
   // gmres_amg_block: split, AMG on block 1 (its prolongators kept while its
   // pattern stays, as gmres_amg's), UMFPACK on block 2 (its analysis kept likewise).
-  // `refresh_amg` false: block 1's AMG as it is (lagged; the split and block 2's
-  // LU are always this matrix's: the balloon and the stent change most between
-  // iterations, and their exact block solve is what keeps GMRES short).
+  // `refresh_amg` false (lagged): block 1's AMG and block 2's LU as the last set-up
+  // left them, the split (the coupling block A21 of the sweep) this matrix's.
   RCP<OP> block_preconditioner(const CsrMatrix& a, const RCP<const Map>& map, LinearSolveStats& stats, bool refresh_amg) {
     if (block_end_ <= block_begin_)
       throw std::logic_error("gmres_amg_block: no AMG block was set (set_amg_block)");
@@ -489,7 +496,15 @@ class TrilinosSolver : public LinearSolver {
       block_amg_seconds_ = seconds(t0, Clock::now());
     }
     stats.amg_levels = block_amg_->GetHierarchy()->GetNumLevels();
-    block_lu_.factor(split_.a22);
+    // Block 2's LU is lagged with block 1's AMG (LagPolicy is charged both set-ups):
+    // solves read the factors only, so those of an earlier a22 serve any later one of
+    // its size (the contact entries between balloon and stent come and go).
+    if (refresh_amg || block_lu_.rows() != split_.a22.rows) {
+      const auto t0 = Clock::now();
+      block_lu_.factor(split_.a22);
+      ++stats.lu_factorizations;
+      block_lu_seconds_ = seconds(t0, Clock::now());
+    }
     return rcp(new BlockGaussSeidel(map, block_map_, block_amg_, split_, block_lu_));
   }
 
@@ -631,6 +646,7 @@ class TrilinosSolver : public LinearSolver {
   RCP<MueLu::TpetraOperator<SC, LO, GO, NO>> block_amg_;
   RCP<const Map> block_map_;  // block 1's map (its AMG's)
   double block_amg_seconds_ = 0.0;  // the last set-up of block 1's AMG
+  double block_lu_seconds_ = 0.0;   // and of block 2's LU
   UmfpackFactor block_lu_{false};  // no iterative refinement: GMRES corrects the block solve
   UmfpackFactor whole_lu_{false};  // gmres_lu's factors (likewise unrefined)
   Eigen::MatrixXd modes_;
@@ -640,6 +656,8 @@ class TrilinosSolver : public LinearSolver {
 };
 
 }  // namespace
+
+void initialize_parallel() { ensure_initialized(); }
 
 std::unique_ptr<LinearSolver> make_trilinos_solver(const LinearSolverSettings& settings) {
   return std::make_unique<TrilinosSolver>(settings);

@@ -63,9 +63,12 @@ void UmfpackFactor::release() {
 void UmfpackFactor::factor(const CsrMatrix& a) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  rows_ = -1;  // until this factorization succeeds
   a_ = refine_ ? &a : nullptr;
-  rows_ = a.rows;
-  if (a.rows == 0) return;
+  if (a.rows == 0) {
+    rows_ = 0;
+    return;
+  }
   const SuiteSparse_long n = a.rows;
   const auto* ap = reinterpret_cast<const SuiteSparse_long*>(a.row_ptr.data());
   const auto* ai = reinterpret_cast<const SuiteSparse_long*>(a.cols.data());
@@ -90,9 +93,11 @@ void UmfpackFactor::factor(const CsrMatrix& a) {
     if (numeric_) umfpack_dl_free_numeric(&numeric_);
     throw std::runtime_error("UMFPACK factorization failed: " + umfpack_status_text(st));
   }
+  rows_ = a.rows;
 }
 
 void UmfpackFactor::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  if (rows_ < 0) throw std::logic_error("UmfpackFactor::solve: no factorization (none made, or the last one failed)");
   x.resize(b.size());
   if (rows_ == 0) return;
   // Without refinement UMFPACK does not read A (umfpack_solve.h: the arrays may then be NULL).

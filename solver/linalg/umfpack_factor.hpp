@@ -1,8 +1,8 @@
 #pragma once
 // One SuiteSparse UMFPACK factorization (Davis 2004, ACM TOMS 30(2)) of a
 // CSR matrix, solved against many right-hand sides: the direct solver
-// (umfpack_solver.cpp) and the direct block of gmres_amg_block's
-// preconditioner (trilinos_solvers.cpp) share it.
+// (umfpack_solver.cpp), the direct block of gmres_amg_block's preconditioner
+// and gmres_lu's preconditioner (trilinos_solvers.cpp) share it.
 //
 // The symbolic analysis depends on the pattern only, so it is kept while the
 // pattern stays the same (every Newton iteration of a solid scene) and only
@@ -34,12 +34,14 @@ class UmfpackFactor {
   void factor(const CsrMatrix& a);
   /// x = A⁻¹ b with the last factorization.
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+  /// Rows of the last successful factorization; -1 before one and after a failed one
+  /// (whose earlier factors are gone).
   std::int64_t rows() const { return rows_; }
 
  private:
   void release();
   bool refine_ = true;
-  std::int64_t rows_ = 0;
+  std::int64_t rows_ = -1;
   const CsrMatrix* a_ = nullptr;  // for the refinement only
   double control_[20]{};      // UMFPACK_CONTROL
   mutable double info_[90]{};  // UMFPACK_INFO

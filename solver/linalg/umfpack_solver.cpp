@@ -24,6 +24,7 @@ class UmfpackSolver : public LinearSolver {
     const auto t2 = Clock::now();
     LinearSolveStats s;
     s.iterations = 1;
+    s.lu_factorizations = 1;
     s.relative_residual = (a.multiply(x) - b).norm() / std::max(b.norm(), 1e-300);
     // A nearly singular matrix factors without UMFPACK's singular warning but
     // gives a useless solution: not "converged" then (Newton logs it).

@@ -256,12 +256,14 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     const bool r_ok = r_norm <= settings.residual_tolerance * scale + settings.residual_absolute;
     const bool du_ok = du_error <= settings.increment_tolerance * std::max(u.norm(), 1e-12) ||
                        du_norm <= settings.increment_absolute || r_norm == 0.0;
-    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}, forces {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}{}{}, set-up {:.2f} s, "
+    log::debug("  newton {}: |R| = {:.3e} (scale {:.3e}, forces {:.3e}), |du| = {:.3e}, alpha = {:g}, linear its {}{}{}{}{}, set-up {:.2f} s, "
                "solve {:.2f} s", it, r_norm, scale, res.force_magnitude, du_norm, best_alpha, ls.iterations,
                eta > 0.0 ? fmt::format(" to {:.1e}", eta) : std::string(),
                ls.amg_levels > 0 ? fmt::format(" (AMG levels {}{})", ls.amg_levels, ls.preconditioner_built ? ", built" : "")
                                  : std::string(),
                ls.preconditioner_lagged ? " (preconditioner lagged)" : "",
+               ls.lu_factorizations > 0 ? fmt::format(" ({} LU factorization{})", ls.lu_factorizations, ls.lu_factorizations > 1 ? "s" : "")
+                                        : std::string(),
                ls.setup_seconds,
                ls.solve_seconds);
     if (model.dofs.ranges().size() > 1) log::debug("    |R| by part: {}", residual_by_owner(model, system.residual()));
