@@ -55,10 +55,16 @@ int solve(const SceneDesc& scene, const SolveOptions& options, Summary& summary)
     log::info("gmres_amg_block: AMG on body '{}' ({} unknowns), UMFPACK LU on the other {}", block.body, block.end - block.begin,
               model.dofs.size() - (block.end - block.begin));
   }
-  // Ranks: after the linear solver exists (Trilinos initialises MPI when the
-  // CLI has not). Every rank holds u; elements are split; rank 0 writes.
+  // Ranks: MPI is initialised here when the CLI has not. Every rank holds u;
+  // elements are split; rank 0 writes.
+  initialize_parallel();
   model.rank = parallel::rank();
   model.ranks = parallel::size();
+  // Every rank refuses alike (no collective has run): these solvers would see one rank's rows only.
+  if (one_rank_only(linear_settings.type) && model.ranks > 1)
+    throw InputError(fmt::format("{}: linear solver {} runs on one MPI rank in this version (solver.linear.type, or "
+                                 "--linear-solver); on {} ranks use direct, gmres_ilu or gmres_amg",
+                                 file, linear_solver_name(linear_settings.type), model.ranks));
   const bool writes = model.rank == 0;
   if (!writes) log::set_level(log::Level::warn);
   // Threads of the element loops: the option, else $STENTSIM_THREADS, else this node's cores over the ranks.

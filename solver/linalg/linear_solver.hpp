@@ -99,6 +99,10 @@ class LinearSolver {
 };
 
 std::unique_ptr<LinearSolver> make_linear_solver(const LinearSolverSettings& settings);
+/// Initialises MPI (through Tpetra, as the Trilinos solvers do) unless it is already,
+/// so a process started by mpirun knows its rank and the rank count whatever solver it
+/// runs (eigen_lu alone never touches MPI).
+void initialize_parallel();
 
 /// The Eigen SparseLU reference solver (single rank).
 std::unique_ptr<LinearSolver> make_eigen_lu_solver();
