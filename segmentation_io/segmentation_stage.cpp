@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
+
 #include "common/error.hpp"
 #include "common/log.hpp"
 #include "common/mesh_tags.hpp"
@@ -183,22 +186,54 @@ TriSurface load_checked_surface(const std::filesystem::path& file, const Surface
   return check_and_repair(std::move(raw), checks, file.string(), report);
 }
 
-TriSurface load_stage_surface(const std::filesystem::path& file, const std::string& tool) {
-  if (file.extension() != ".vtp")  // the stages read VTP only
-    throw InputError(fmt::format("{}: {} reads VTP surfaces (.vtp); `stentsim segmentation` writes one from a .vtp, .vtk, "
-                                 ".stl or .obj (a case file's input.surface.lumen or .wall)", file.string(), tool));
-  SurfaceCheckOptions checks;
-  checks.repair = false;
-  checks.repair_off_note = tool + " does not repair surfaces";
-  checks.units_key = "input.surface.units";
-  SurfaceReport report;
+namespace {
+
+/// `check` with the hint of load_stage_surface added to its InputError.
+template <typename Check>
+auto with_stage_hint(const std::string& tool, Check check) {
   try {
-    return load_checked_surface(file, checks, report);
+    return check();
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}\n{} takes surfaces in mm as `stentsim segmentation` writes them: run that on this "
                                  "file (a case file's input.surface.lumen or .wall, with its units) to check, scale and "
                                  "repair it", e.what(), tool));
   }
+}
+
+}  // namespace
+
+TriSurface load_stage_surface(const std::filesystem::path& file, const std::string& tool) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  SurfaceCheckOptions checks;
+  checks.repair = false;
+  checks.repair_off_note = tool + " does not repair surfaces";
+  checks.units_key = "input.surface.units";
+  SurfaceReport report;
+  return with_stage_hint(tool, [&] {
+    if (ext != ".vtp")  // the stages read VTP only
+      throw InputError(fmt::format("{}: {} reads VTP surfaces (.vtp), not {}", file.string(), tool,
+                                   ext.empty() ? "a file without an extension" : ext));
+    return load_checked_surface(file, checks, report);
+  });
+}
+
+TriSurface load_stage_lumen(const std::filesystem::path& file, const std::string& tool) {
+  TriSurface lumen = load_stage_surface(file, tool);
+  with_stage_hint(tool, [&] {
+    CenterlineOptions co;  // the default stenosis rule, as the segmentation stage's units rule without a case
+    check_reference_diameter_units(robust_reference_diameter(compute_centerline(lumen, co).stenoses), "mm", file.string(),
+                                   "input.surface.units");
+  });
+  return lumen;
+}
+
+void check_stage_wall(const TriSurface& lumen, const TriSurface& wall, const std::filesystem::path& lumen_file,
+                      const std::filesystem::path& wall_file, const std::string& tool) {
+  with_stage_hint(tool, [&] {
+    check_wall_encloses_lumen(lumen, wall, lumen_file.string(),
+                              "the wall " + wall_file.string() + "; is it the outer surface of the same vessel, in mm?");
+  });
 }
 
 void report_to_summary(const std::string& prefix, const SurfaceReport& r, Summary& s) {
@@ -383,6 +418,13 @@ void run_segmentation_stage(const SegmentationInput& input, const std::filesyste
                        : kind == "simvascular" ? "give the outer wall's contours (input.simvascular.wall)"
                                                : "label the wall in the image (input.label_image.wall_label)";
     wall = synthesize_wall(lumen, synthesis, summary, &lumen_centerline);
+    {  // The checks a wall file gets, repairs off (as `stentsim mesh` gives wall.vtp).
+      SurfaceCheckOptions wall_checks;
+      wall_checks.repair = false;
+      wall_checks.repair_off_note = "a synthesized wall is not repaired; " + synthesis.remedy;
+      SurfaceReport wr;
+      wall = check_and_repair(std::move(wall), wall_checks, "the wall synthesized from " + lumen_name, wr);
+    }
     check_wall_encloses_lumen(lumen, wall, lumen_name, "the wall synthesized from it; " + synthesis.remedy);
     summary.set_text("wall_source", "synthesized from the lumen");
     summary.set("wall_remodeling", synthesis.remodeling);

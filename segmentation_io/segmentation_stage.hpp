@@ -134,11 +134,17 @@ TriSurface load_checked_surface(const std::filesystem::path& file, const Surface
                                 SurfaceReport& report);
 
 /// A lumen or wall surface handed to a tool as a file (`stentsim mesh`, `stentsim
-/// place`): read by extension and given the surface checks in mm with repairs
-/// off, which the segmentation stage's outputs pass. The error names the file
-/// and says that `stentsim segmentation` (an input.surface section) scales and
-/// repairs such a surface; `tool` is the command, for that message.
+/// place`): read (VTP, as the stages read it) and given the surface checks in mm with
+/// repairs off, which the segmentation stage's outputs pass. Its errors name the file
+/// and say that `stentsim segmentation` (an input.surface section) scales and repairs
+/// such a surface; `tool` is the command, for that message.
 TriSurface load_stage_surface(const std::filesystem::path& file, const std::string& tool);
+/// load_stage_surface for a lumen, with the case path's units rule too (its reference
+/// diameter by its own centerline, the default stenosis rule).
+TriSurface load_stage_lumen(const std::filesystem::path& file, const std::string& tool);
+/// check_wall_encloses_lumen for the tools' files, with load_stage_surface's hint.
+void check_stage_wall(const TriSurface& lumen, const TriSurface& wall, const std::filesystem::path& lumen_file,
+                      const std::filesystem::path& wall_file, const std::string& tool);
 
 /// InputError unless a sample of the lumen's points (its end rings aside) lies
 /// inside the wall capped at its ends; `wall_what` says which wall, for the message.

@@ -264,7 +264,7 @@ TEST_F(Cli, StandAloneCenterlineRefusesACorruptedSurface) {
 }
 
 // `mesh` and `place` take lumen.vtp (and wall.vtp) as files and give them the case path's
-// surface checks, repairs off: a damaged, holed, mis-scaled or swapped surface is refused
+// surface checks and units rule, repairs off: a damaged, holed, mis-scaled or swapped surface is refused
 // (exit 2, the file named, what mends it said) before gmsh or the placement sees it, and
 // nothing is written. The intact phantom passes (the other mesh and place tests).
 TEST_F(Cli, StandAloneMeshAndPlaceRunTheSurfaceChecks) {
@@ -281,10 +281,11 @@ TEST_F(Cli, StandAloneMeshAndPlaceRunTheSurfaceChecks) {
   const Eigen::Vector3d centre = (lumen.points.front() + lumen.points.back()) / 2;
   for (std::size_t i = 0; i < lumen.points.size(); ++i)
     if ((lumen.points[i] - centre).norm() < (lumen.points[mid] - centre).norm()) mid = i;
-  auto flipped = lumen, holed = lumen, in_um = lumen;
+  auto flipped = lumen, holed = lumen, in_um = lumen, in_cm = lumen;
   flipped.points[mid].x() = -flipped.points[mid].x();
   holed.triangles.erase(holed.triangles.begin() + long(holed.triangles.size() / 2));
-  for (auto& p : in_um.points) p *= 1000.0;
+  for (auto& p : in_um.points) p *= 1000.0;  // outside the size window
+  for (auto& p : in_cm.points) p *= 0.1;     // inside it: the reference-diameter rule
   const std::string wall = d + "/ph/wall.vtp", cl = d + "/ph/centerline_true.vtp";
   fs::copy_file(dir / "ph/lumen.vtp", dir / "lumen.stl");
   struct Bad {
@@ -294,6 +295,7 @@ TEST_F(Cli, StandAloneMeshAndPlaceRunTheSurfaceChecks) {
       {write("flipped.vtp", flipped), wall, "flipped.vtp: the surface intersects itself"},
       {write("holed.vtp", holed), wall, "(stentsim mesh does not repair surfaces)"},
       {write("in_um.vtp", in_um), wall, "set input.surface.units: um"},
+      {write("in_cm.vtp", in_cm), wall, "in_cm.vtp: the lumen's reference diameter is 0.1"},
       {d + "/lumen.stl", wall, "lumen.stl: stentsim mesh reads VTP surfaces"},
       {wall, d + "/ph/lumen.vtp", "lie outside the wall " + d + "/ph/lumen.vtp"},
       {d + "/ph/lumen.vtp", d + "/flipped.vtp", "flipped.vtp: the surface intersects itself"}};
@@ -301,9 +303,9 @@ TEST_F(Cli, StandAloneMeshAndPlaceRunTheSurfaceChecks) {
     r = sh("mesh --lumen " + b.lumen + " --wall " + b.wall + " --centerline " + cl + " --out " + d + "/mesh");
     EXPECT_EQ(r.code, 2) << b.lumen << ": " << r.out;
     EXPECT_NE(r.out.find(b.says), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("stentsim mesh takes surfaces in mm as `stentsim segmentation` writes them"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(dir / "mesh")) << b.lumen;
   }
-  EXPECT_NE(r.out.find("stentsim mesh takes surfaces in mm as `stentsim segmentation` writes them"), std::string::npos) << r.out;
   r = sh("place --centerline " + cl + " --lumen " + d + "/flipped.vtp --out " + d + "/pl");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("flipped.vtp: the surface intersects itself"), std::string::npos) << r.out;

@@ -59,7 +59,7 @@ void register_device(CLI::App& app) {
     Summary s;
     std::optional<fs::path> lumen;
     if (!a->lumen.empty()) {
-      (void)segmentation::load_stage_surface(a->lumen, "stentsim place");  // the case path's surface checks
+      (void)segmentation::load_stage_lumen(a->lumen, "stentsim place");  // the case path's surface checks
       lumen = a->lumen;
     }
     device_gen::run_placement_stage(d.placement, a->centerline, lumen, d.balloon, d.stent, out / "placement.yaml",

@@ -42,10 +42,9 @@ void register_mesh(CLI::App& app) {
     const std::filesystem::path out(a->out);
     // The case path's surface checks (there its segmentation stage runs them):
     // a damaged or mis-scaled surface fails here, naming its file, before gmsh sees it.
-    const auto lumen = segmentation::load_stage_surface(a->lumen, "stentsim mesh");
+    const auto lumen = segmentation::load_stage_lumen(a->lumen, "stentsim mesh");
     const auto wall = segmentation::load_stage_surface(a->wall, "stentsim mesh");
-    segmentation::check_wall_encloses_lumen(lumen, wall, a->lumen,
-                                            "the wall " + a->wall + "; is it the outer surface of the same vessel, in mm?");
+    segmentation::check_stage_wall(lumen, wall, a->lumen, a->wall, "stentsim mesh");
     std::filesystem::create_directories(out);
     meshing::run_patient_mesh(a->lumen, a->wall, a->centerline, a->o, out / "artery.vtu", out / "artery.msh", summary);
     summary.write(out / "summary.yaml");
