@@ -27,9 +27,9 @@ struct BlockSplit {
   std::int64_t full_of_outer(std::int64_t k) const { return k < begin ? k : k + (end - begin); }
 };
 
-/// Splits `a` (one rank: the whole matrix). Throws std::invalid_argument when
-/// the range is empty or leaves no block 2.
-BlockSplit split_blocks(const CsrMatrix& a, std::int64_t begin, std::int64_t end);
+/// Splits `a` (one rank: the whole matrix) into `out`, reusing its storage. Throws
+/// std::invalid_argument when the range is empty or leaves no block 2.
+void split_blocks(const CsrMatrix& a, std::int64_t begin, std::int64_t end, BlockSplit& out);
 
 /// The matrix block 1's AMG is built from: A11 without its exact zeros (diagonal kept).
 /// Contact pairs reserve entries that stay zero until a point comes within reach; an AMG
