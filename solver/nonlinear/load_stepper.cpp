@@ -68,7 +68,10 @@ void run_load_steps(Model& model, GlobalSystem& system, LinearSolver& linear, Ei
                      guess.norm(), (nr.increment - guess).norm());
         last_increment = nr.increment;
         last_h = h;
-        if (nr.iterations <= s.easy_iterations && cuts == 0) {
+        // A step taken at the residual floor spent its last floor_iterations confirming that
+        // no iteration lowers |R| further: its difficulty is the iterations that reached it.
+        const int work = nr.at_floor ? std::max(1, nr.iterations - newton.floor_iterations) : nr.iterations;
+        if (work <= s.easy_iterations && cuts == 0) {
           dt = std::min(dt * s.grow_factor, s.dt_max);
           cuts_since_easy = 0;
         }

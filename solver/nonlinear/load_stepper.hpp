@@ -37,6 +37,7 @@ struct StepperSettings {
   int max_consecutive_cuts = 12;  // cuts since the last easy (growing) step before giving up
   double cut_factor = 0.5, grow_factor = 1.5;
   int easy_iterations = 5;     // grow after a step with at most this many Newton iterations
+                               // (at the residual floor: not counting the floor_iterations that confirmed it)
   std::vector<double> stops;   // times a step must end on
   // Stops where a load curve changes slope: the next load may act quite
   // differently (the balloon's inflation after the artery's prestress), so the

@@ -147,7 +147,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
   }
   res.residual_norms.push_back(r_norm);
 
-  int steady = 0;               // consecutive iterations that neither halved |R| nor changed an active set (floor test)
+  int steady = 0;               // consecutive iterations that kept floor_reduction of |R| and changed no active set (floor test)
   double prev_du_norm = 0.0;    // the last iteration's correction
   bool prev_full_step = false;  // ... and whether the line search took all of it
   double eta = 0.0, prev_r_norm = 0.0;  // the forcing term of the last solve and the residual it started from
@@ -236,7 +236,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     const int changes = model.accepted_changes();
     const double r_before = r_norm;
     r_norm = system.free_residual_norm();
-    steady = r_norm >= 0.9 * r_before && changes == 0 ? steady + 1 : 0;
+    steady = r_norm >= settings.floor_reduction * r_before && changes == 0 ? steady + 1 : 0;
     res.force_magnitude = system.force_magnitude_norm();
     scale = std::max(scale, reaction_norm(model.constraints, system.residual()));
     res.residual_norms.push_back(r_norm);
@@ -281,8 +281,8 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     if (!r_ok && settings.floor_tolerance > 0.0 && steady >= settings.floor_iterations &&
         within_floor(model, system, settings.floor_tolerance, settings.residual_tolerance * scale + settings.residual_absolute)) {
       log::debug("  converged at the residual floor: |R| = {:.3e} within {:g} of each part's forces in balance (all: {:.3e}), "
-                 "reduced by less than a tenth and no active set changed in {} iterations",
-                 r_norm, settings.floor_tolerance, res.force_magnitude, steady);
+                 "each keeping more than {:g} of |R| with no active set changed, {} iterations in a row",
+                 r_norm, settings.floor_tolerance, res.force_magnitude, settings.floor_reduction, steady);
       res.converged = res.at_floor = true;
       return res;
     }

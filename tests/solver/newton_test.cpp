@@ -172,6 +172,98 @@ TEST(SolverNewton, ResidualFloorIsTakenAsConvergedOnlyWhenSmallAgainstTheForcesA
   EXPECT_FALSE(solve(amplitude, floor_tolerance, u, true).converged);
 }
 
+// A floor the state creeps along: a residual the tangent cannot see that falls to 70 %
+// at each accepted iterate (as the damped iterations of the patient example's deflation,
+// 10-30 % less per iteration at 1e-6 of its forces). It is a floor by the default rule:
+// each iteration keeps more than floor_reduction (0.5) of |R|; with floor_reduction 0.8 it
+// is progress, and the step runs out of iterations long before 0.7^k reaches the tolerance.
+class CreepingFloorTerm : public Term {
+ public:
+  CreepingFloorTerm(std::vector<GlobalDof> dofs, double amplitude) : dofs_(std::move(dofs)), amplitude_(amplitude) {}
+  std::string name() const override { return "creeping floor"; }
+  void assemble(const SystemState&, Assembler& out) override {
+    const Eigen::VectorXd r = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(dofs_.size()), amplitude_ * std::pow(0.7, accepted_));
+    out.add(dofs_, r, Eigen::MatrixXd::Zero(r.size(), r.size()));
+  }
+  void accept() override { ++accepted_; }
+  void begin_step(const SystemState&) override { accepted_ = 0; }  // each load step creeps anew
+
+ private:
+  std::vector<GlobalDof> dofs_;
+  double amplitude_;
+  int accepted_ = 0;
+};
+
+TEST(SolverNewton, AResidualThatKeepsMoreThanFloorReductionIsAtItsFloor) {
+  auto solve = [](double floor_reduction, double amplitude_of_forces) {
+    auto b = make_neo_hooke_block(box_hex8(2, 2, 4, 1.0, 1.0, 2.0));
+    b->model.add_term<RobinSprings>("springs", *b->body, b->bottom, 100.0);
+    b->model.add_term<FollowerPressure>("pressure", *b->body, b->top, 0.1, LoadCurve::ramp(0, 1));
+    std::vector<GlobalDof> top;
+    for (std::size_t i = 0; i < b->body->num_nodes(); ++i)
+      if (b->body->mesh().points[i].z() > 2 - 1e-9) top.push_back(b->body->dof(i, 0));
+    // 0.1 MPa on the 1 mm^2 top face: forces in balance of about 0.1 N.
+    b->model.add_term<CreepingFloorTerm>(top, amplitude_of_forces * 0.1);
+    b->model.size_constraints();
+    GlobalSystem sys(b->model.constraints);
+    auto linear = make_linear_solver({});
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
+    NewtonSettings ns;
+    ns.residual_tolerance = 1e-12;
+    ns.residual_absolute = 0.0;
+    ns.increment_tolerance = 1e-12;
+    ns.floor_tolerance = 1e-6;
+    ns.floor_reduction = floor_reduction;
+    return newton_step(b->model, sys, *linear, u, 1.0, 1.0, ns);
+  };
+  const NewtonResult crept = solve(NewtonSettings{}.floor_reduction, 1e-7);
+  ASSERT_TRUE(crept.converged) << crept.failure;
+  EXPECT_TRUE(crept.at_floor);
+  EXPECT_LT(crept.iterations, 10);
+  EXPECT_FALSE(solve(0.8, 1e-7).converged);  // 0.7 per iteration is progress by that rule
+  EXPECT_FALSE(solve(NewtonSettings{}.floor_reduction, 1e-2).converged);  // far above floor_tolerance: no floor in 20 iterations
+}
+
+// The stepper judges a step taken at the residual floor by the iterations that reached
+// it: the floor_iterations that only confirmed it do not keep the step from growing.
+// easy_iterations is set one below a floor step's count, which the step then exceeds.
+TEST(SolverNewton, AStepAtTheFloorGrowsByTheIterationsThatReachedIt) {
+  auto run = [](int easy_iterations) {
+    auto b = make_neo_hooke_block(box_hex8(2, 2, 4, 1.0, 1.0, 2.0));
+    b->model.add_term<RobinSprings>("springs", *b->body, b->bottom, 100.0);
+    b->model.add_term<FollowerPressure>("pressure", *b->body, b->top, 0.1, LoadCurve::ramp(0, 1));
+    std::vector<GlobalDof> top;
+    for (std::size_t i = 0; i < b->body->num_nodes(); ++i)
+      if (b->body->mesh().points[i].z() > 2 - 1e-9) top.push_back(b->body->dof(i, 0));
+    b->model.add_term<CreepingFloorTerm>(top, 1e-8);
+    b->model.size_constraints();
+    GlobalSystem sys(b->model.constraints);
+    auto linear = make_linear_solver({});
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
+    NewtonSettings ns;
+    ns.residual_tolerance = 1e-12;
+    ns.residual_absolute = 0.0;
+    ns.increment_tolerance = 1e-12;
+    ns.floor_tolerance = 1e-6;
+    StepperSettings st;
+    st.dt_initial = 0.1;
+    st.dt_max = 1.0;
+    st.easy_iterations = easy_iterations;
+    std::vector<StepRecord> steps;
+    run_load_steps(b->model, sys, *linear, u, st, ns, [&](const StepRecord& r) { steps.push_back(r); });
+    return steps;
+  };
+  const auto probe = run(100);
+  ASSERT_GE(probe.size(), 2u);
+  ASSERT_TRUE(probe[0].at_floor);
+  const int n = probe[0].newton_iterations;
+  ASSERT_GT(n, NewtonSettings{}.floor_iterations + 1);
+  const auto steps = run(n - 1);
+  ASSERT_GE(steps.size(), 2u);
+  ASSERT_EQ(steps[0].newton_iterations, n);  // more than easy_iterations ...
+  EXPECT_NEAR(steps[1].dt, 1.5 * steps[0].dt, 1e-12);  // ... and the step still grew
+}
+
 // Prescribed homogeneous deformation on the boundary of a distorted tet10
 // patch: the solver reproduces it at the interior nodes.
 TEST(SolverNewton, PatchTestThroughSolver) {
