@@ -28,6 +28,10 @@ export STENTSIM_THREADS=1
 # the readers fork a child to probe a VTK XML file, and a child forked while TBB's workers
 # are alive in the instrumented parent can hang until the probe's 20 s limit.
 export VTK_SMP_BACKEND_IN_USE=Sequential
+# The fuzz tests' per-input bound (30 s, the release build's) times three: under ASan a
+# zlib .vtu mutant whose blocks claim gigabytes took 36 s (read twice: the probe child,
+# then the reader) with the other core busy; the release build reads all 1,200 in 41 s.
+export STENTSIM_FUZZ_SECONDS=90
 export ASAN_OPTIONS="exitcode=86:max_allocation_size_mb=4096:allocator_may_return_null=1:detect_leaks=1:abort_on_error=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:exitcode=86"
 export LSAN_OPTIONS="suppressions=$here/scripts/lsan-suppressions.txt:print_suppressions=0"
