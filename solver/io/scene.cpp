@@ -381,7 +381,7 @@ SceneDesc read_scene_root(ConfigMap root, const std::filesystem::path& file) {
   scene.newton.increment_tolerance = nw.number("increment_tolerance", 1e-8, Range::positive());
   scene.newton.floor_tolerance = nw.number("floor_tolerance", 1e-6, Range::non_negative());
   scene.newton.floor_iterations = nw.integer("floor_iterations", 2, Range::between(1, 100));
-  scene.newton.floor_reduction = nw.number("floor_reduction", 0.5, Range{0.0, 1.0, false, true});
+  scene.newton.floor_reduction = nw.number("floor_reduction", 0.9, Range{0.0, 1.0, false, true});
   scene.newton.line_search_steps = nw.integer("line_search_steps", 6, Range::between(0, 30));
   scene.newton.predictor = nw.choice("predictor", {"extrapolate", "none"}, "extrapolate") == "extrapolate";
   scene.newton.inexact = nw.choice("forcing", {"eisenstat_walker", "none"}, "eisenstat_walker") == "eisenstat_walker";

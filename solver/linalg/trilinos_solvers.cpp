@@ -429,7 +429,8 @@ class TrilinosSolver : public LinearSolver {
   // local matrix itself, with the row Map as column Map (local column = global column).
   // insertGlobalValues and fillComplete would sort, merge and hash every entry again
   // (1.3 s for the 10 M entries of the bundled patient, paid at each growth of the
-  // contact pattern). Null when a row's columns are not strictly increasing.
+  // contact pattern). Null when a row's columns are not strictly increasing or not all
+  // inside the matrix (the constructor takes them on trust; insertGlobalValues checks them).
   RCP<Matrix> local_matrix(const CsrMatrix& a, const RCP<const Map>& map) const {
     const auto rows = static_cast<std::size_t>(a.rows), nnz = a.cols.size();
     Teuchos::ArrayRCP<std::size_t> ptr(rows + 1);
@@ -438,7 +439,7 @@ class TrilinosSolver : public LinearSolver {
     for (std::size_t i = 0; i <= rows; ++i) ptr[i] = static_cast<std::size_t>(a.row_ptr[i]);
     for (std::size_t i = 0; i < rows; ++i)
       for (auto k = ptr[i]; k < ptr[i + 1]; ++k) {
-        if (k > ptr[i] && a.cols[k] <= a.cols[k - 1]) return Teuchos::null;
+        if ((k > ptr[i] && a.cols[k] <= a.cols[k - 1]) || a.cols[k] < 0 || a.cols[k] >= a.rows) return Teuchos::null;
         ind[k] = static_cast<LO>(a.cols[k]);
       }
     std::copy(a.values.begin(), a.values.end(), val.begin());

@@ -281,7 +281,7 @@ NewtonResult newton_step(Model& model, GlobalSystem& system, LinearSolver& linea
     if (!r_ok && settings.floor_tolerance > 0.0 && steady >= settings.floor_iterations &&
         within_floor(model, system, settings.floor_tolerance, settings.residual_tolerance * scale + settings.residual_absolute)) {
       log::debug("  converged at the residual floor: |R| = {:.3e} within {:g} of each part's forces in balance (all: {:.3e}), "
-                 "each keeping more than {:g} of |R| with no active set changed, {} iterations in a row",
+                 "each keeping at least {:g} of |R| with no active set changed, {} iterations in a row",
                  r_norm, settings.floor_tolerance, res.force_magnitude, settings.floor_reduction, steady);
       res.converged = res.at_floor = true;
       return res;

@@ -31,8 +31,8 @@
 // tolerance but, in every part of the model (each DOF owner: balloon, stent, artery),
 // at or below floor_tolerance times that part's forces in balance (m: the per-DOF
 // sums of the magnitudes of all contributions, GlobalSystem::force_magnitudes), and
-// that in floor_iterations consecutive iterations keeps more than floor_reduction
-// (default half) of |R| and changes no contact active set
+// that in floor_iterations consecutive iterations keeps at least floor_reduction
+// (default 0.9) of |R| and changes no contact active set
 // (Term::accepted_changes: while contact points still enter or leave, the state is
 // on its way, not at a floor) is taken as converged at that floor
 // (NewtonResult::at_floor, counted and reported), instead of being cut: smaller
@@ -59,9 +59,10 @@ struct NewtonSettings {
   double increment_absolute = 0.0;    // |du| at or below this also satisfies the increment test (0: off)
   double floor_tolerance = 1e-6;      // relative to the forces in balance |m| (0: no floor test)
   int floor_iterations = 2;           // ... after this many consecutive iterations without progress:
-  double floor_reduction = 0.5;       // ... each keeping at least this fraction of |R| (Newton near a
-                                      // smooth solution keeps far less; the patient example's deflation
-                                      // crept along its floor by 10-25 % per damped iteration)
+  double floor_reduction = 0.9;       // ... each keeping at least this fraction of |R| (Newton near a
+                                      // smooth solution keeps far less; the case's solve scene sets 0.5:
+                                      // the patient example's deflation creeps along its floor by 10-25 %
+                                      // per damped iteration, workflows/solve_stage.cpp)
   int line_search_steps = 6;          // halvings
   bool predictor = true;              // the stepper starts each step from the last step's increment, extrapolated
   /// Krylov solvers stop at the Eisenstat-Walker forcing term instead of their fixed tolerance
