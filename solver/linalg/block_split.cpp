@@ -18,20 +18,8 @@ void split_blocks(const CsrMatrix& a, std::int64_t begin, std::int64_t end, Bloc
   s.a11.row_ptr.reserve(static_cast<std::size_t>(n1) + 1);
   s.a21.row_ptr.reserve(static_cast<std::size_t>(n2) + 1);
   s.a22.row_ptr.reserve(static_cast<std::size_t>(n2) + 1);
-  // Sizes first: the split runs at every linear solve, into the last split's
-  // storage (no fresh pages of a hundred megabytes to fault in each time).
-  std::size_t n11 = 0, n21 = 0, n22 = 0;
-  for (std::int64_t i = 0; i < a.rows; ++i) {
-    const bool inner_row = i >= begin && i < end;
-    for (auto k = a.row_ptr[static_cast<std::size_t>(i)]; k < a.row_ptr[static_cast<std::size_t>(i) + 1]; ++k) {
-      const std::int64_t j = a.cols[static_cast<std::size_t>(k)];
-      const bool inner_col = j >= begin && j < end;
-      n11 += inner_row && inner_col, n21 += !inner_row && inner_col, n22 += !inner_row && !inner_col;
-    }
-  }
-  s.a11.cols.reserve(n11), s.a11.values.reserve(n11);
-  s.a21.cols.reserve(n21), s.a21.values.reserve(n21);
-  s.a22.cols.reserve(n22), s.a22.values.reserve(n22);
+  // Into the last split's storage: cleared vectors keep their capacity, so after the first
+  // solve no fresh pages of a hundred megabytes are faulted in at every linear solve.
   for (std::int64_t i = 0; i < a.rows; ++i) {
     const bool inner_row = i >= begin && i < end;
     for (auto k = a.row_ptr[static_cast<std::size_t>(i)]; k < a.row_ptr[static_cast<std::size_t>(i) + 1]; ++k) {

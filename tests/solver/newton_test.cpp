@@ -194,27 +194,39 @@ class CreepingFloorTerm : public Term {
   int accepted_ = 0;
 };
 
-TEST(SolverNewton, AResidualThatKeepsMoreThanFloorReductionIsAtItsFloor) {
-  auto solve = [](double floor_reduction, double amplitude_of_forces) {
-    auto b = make_neo_hooke_block(box_hex8(2, 2, 4, 1.0, 1.0, 2.0));
+// The loaded block with a creeping floor of `amplitude` N on its top face's x DOFs (0.1 MPa
+// on the 1 mm^2 top face: forces in balance of about 0.1 N), and Newton settings whose
+// tolerances only the floor test can meet.
+struct CreepingBlock {
+  std::unique_ptr<NeoHookeBlock> b;
+  std::unique_ptr<GlobalSystem> sys;
+  std::unique_ptr<LinearSolver> linear;
+  Eigen::VectorXd u;
+  NewtonSettings ns;
+
+  CreepingBlock(double amplitude, double floor_reduction) : b(make_neo_hooke_block(box_hex8(2, 2, 4, 1.0, 1.0, 2.0))) {
     b->model.add_term<RobinSprings>("springs", *b->body, b->bottom, 100.0);
     b->model.add_term<FollowerPressure>("pressure", *b->body, b->top, 0.1, LoadCurve::ramp(0, 1));
     std::vector<GlobalDof> top;
     for (std::size_t i = 0; i < b->body->num_nodes(); ++i)
       if (b->body->mesh().points[i].z() > 2 - 1e-9) top.push_back(b->body->dof(i, 0));
-    // 0.1 MPa on the 1 mm^2 top face: forces in balance of about 0.1 N.
-    b->model.add_term<CreepingFloorTerm>(top, amplitude_of_forces * 0.1);
+    b->model.add_term<CreepingFloorTerm>(top, amplitude);
     b->model.size_constraints();
-    GlobalSystem sys(b->model.constraints);
-    auto linear = make_linear_solver({});
-    Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
-    NewtonSettings ns;
+    sys = std::make_unique<GlobalSystem>(b->model.constraints);
+    linear = make_linear_solver({});
+    u = Eigen::VectorXd::Zero(b->model.dofs.size());
     ns.residual_tolerance = 1e-12;
     ns.residual_absolute = 0.0;
     ns.increment_tolerance = 1e-12;
     ns.floor_tolerance = 1e-6;
     ns.floor_reduction = floor_reduction;
-    return newton_step(b->model, sys, *linear, u, 1.0, 1.0, ns);
+  }
+};
+
+TEST(SolverNewton, AResidualThatKeepsMoreThanFloorReductionIsAtItsFloor) {
+  auto solve = [](double floor_reduction, double amplitude_of_forces) {
+    CreepingBlock c(amplitude_of_forces * 0.1, floor_reduction);
+    return newton_step(c.b->model, *c.sys, *c.linear, c.u, 1.0, 1.0, c.ns);
   };
   const NewtonResult crept = solve(0.5, 1e-7);
   ASSERT_TRUE(crept.converged) << crept.failure;
@@ -233,29 +245,13 @@ TEST(SolverNewton, AResidualThatKeepsMoreThanFloorReductionIsAtItsFloor) {
 // easy_iterations is set one below a floor step's count, which the step then exceeds.
 TEST(SolverNewton, AStepAtTheFloorGrowsByTheIterationsThatReachedIt) {
   auto run = [](int easy_iterations) {
-    auto b = make_neo_hooke_block(box_hex8(2, 2, 4, 1.0, 1.0, 2.0));
-    b->model.add_term<RobinSprings>("springs", *b->body, b->bottom, 100.0);
-    b->model.add_term<FollowerPressure>("pressure", *b->body, b->top, 0.1, LoadCurve::ramp(0, 1));
-    std::vector<GlobalDof> top;
-    for (std::size_t i = 0; i < b->body->num_nodes(); ++i)
-      if (b->body->mesh().points[i].z() > 2 - 1e-9) top.push_back(b->body->dof(i, 0));
-    b->model.add_term<CreepingFloorTerm>(top, 1e-8);
-    b->model.size_constraints();
-    GlobalSystem sys(b->model.constraints);
-    auto linear = make_linear_solver({});
-    Eigen::VectorXd u = Eigen::VectorXd::Zero(b->model.dofs.size());
-    NewtonSettings ns;
-    ns.residual_tolerance = 1e-12;
-    ns.residual_absolute = 0.0;
-    ns.increment_tolerance = 1e-12;
-    ns.floor_tolerance = 1e-6;
-    ns.floor_reduction = 0.5;
+    CreepingBlock c(1e-8, 0.5);
     StepperSettings st;
     st.dt_initial = 0.1;
     st.dt_max = 1.0;
     st.easy_iterations = easy_iterations;
     std::vector<StepRecord> steps;
-    run_load_steps(b->model, sys, *linear, u, st, ns, [&](const StepRecord& r) { steps.push_back(r); });
+    run_load_steps(c.b->model, *c.sys, *c.linear, c.u, st, c.ns, [&](const StepRecord& r) { steps.push_back(r); });
     return steps;
   };
   const auto probe = run(100);
