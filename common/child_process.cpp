@@ -24,37 +24,41 @@ namespace {
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
 
-/// The child's part of spawn(): group, signals, parent link, folder, log,
-/// environment. Only async-signal-safe calls until the body runs, except
-/// setenv (the child is single-threaded after fork as far as it matters).
-void set_up_child(const ChildSetup& s, pid_t parent) {
+/// The child's part of spawn(): group, signals, parent link, folder, output,
+/// environment. Only async-signal-safe calls, except setenv for a
+/// setup.env that spawn_exec has not already folded into its envp.
+void set_up_child(const ChildSetup& s, pid_t parent, int output_fd) {
   ::signal(SIGINT, SIG_DFL);
   ::signal(SIGTERM, SIG_DFL);
+  ::signal(SIGCHLD, SIG_DFL);
+  // A parent in StopSignals::Mode::wait_for_signal has these blocked; the
+  // child starts with them deliverable, so a stop reaches it.
+  sigset_t stop;
+  sigemptyset(&stop);
+  for (int sig : {SIGINT, SIGTERM, SIGCHLD}) sigaddset(&stop, sig);
+  ::sigprocmask(SIG_UNBLOCK, &stop, nullptr);
   ::setpgid(0, 0);
   ::prctl(PR_SET_PDEATHSIG, SIGTERM);
   if (::getppid() != parent) ::_exit(1);  // the parent died before prctl took effect
   if (!s.cwd.empty() && ::chdir(s.cwd.c_str()) != 0) ::_exit(126);
-  if (!s.log.empty()) {
-    const int fd = ::open(s.log.c_str(), O_WRONLY | O_CREAT | (s.append_log ? O_APPEND : O_TRUNC), 0644);
-    if (fd >= 0) {
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      ::close(fd);
-    }
+  int fd = output_fd;
+  if (fd < 0 && !s.log.empty()) fd = ::open(s.log.c_str(), O_WRONLY | O_CREAT | (s.append_log ? O_APPEND : O_TRUNC), 0644);
+  if (fd >= 0) {
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    if (fd > 2) ::close(fd);
   }
   for (const auto& [name, value] : s.env) ::setenv(name.c_str(), value.c_str(), 1);
 }
 
-}  // namespace
-
-pid_t spawn(const std::function<int()>& body, const ChildSetup& setup) {
-  if (!setup.log.empty() && setup.log.has_parent_path()) fs::create_directories(setup.log.parent_path());
+pid_t spawn_with_output(const std::function<int()>& body, const ChildSetup& setup, int output_fd) {
+  if (output_fd < 0 && !setup.log.empty() && setup.log.has_parent_path()) fs::create_directories(setup.log.parent_path());
   std::fflush(nullptr);  // nothing buffered is written twice
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) throw ComputeError(fmt::format("cannot start a child process: fork failed: {}", std::strerror(errno)));
   if (pid == 0) {
-    set_up_child(setup, parent);
+    set_up_child(setup, parent, output_fd);
     int code = 1;
     try {
       code = body();
@@ -70,6 +74,41 @@ pid_t spawn(const std::function<int()>& body, const ChildSetup& setup) {
   return pid;
 }
 
+/// argv and the environment (ours with setup.env applied) as execvpe wants
+/// them, built before fork: the child of a multithreaded parent must not
+/// allocate (another thread may have held the allocator's lock at the fork).
+struct ExecArgs {
+  std::vector<std::string> argv_s, env_s;
+  std::vector<char*> argv, envp;
+  ExecArgs(const std::vector<std::string>& args, const std::vector<std::pair<std::string, std::string>>& env) : argv_s(args) {
+    for (char** e = environ; *e; ++e) {
+      const std::string kv = *e;
+      const std::string key = kv.substr(0, kv.find('='));
+      bool replaced = false;
+      for (const auto& [k, v] : env) replaced = replaced || k == key;
+      if (!replaced) env_s.push_back(kv);
+    }
+    for (const auto& [k, v] : env) env_s.push_back(k + "=" + v);
+    for (auto& s : argv_s) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    for (auto& s : env_s) envp.push_back(s.data());
+    envp.push_back(nullptr);
+  }
+};
+
+/// The exec body of spawn_exec and run_captured: exit 127 when it cannot execute.
+int exec_body(ExecArgs& a) {
+  ::execvpe(a.argv[0], a.argv.data(), a.envp.data());
+  const char* why = std::strerror(errno);  // glibc's table: no allocation
+  for (const char* part : {"cannot execute ", static_cast<const char*>(a.argv[0]), ": ", why, "\n"})
+    if (::write(2, part, std::strlen(part)) < 0) break;
+  ::_exit(127);
+}
+
+}  // namespace
+
+pid_t spawn(const std::function<int()>& body, const ChildSetup& setup) { return spawn_with_output(body, setup, -1); }
+
 fs::path self_executable() {
   char buf[4096];
   const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
@@ -80,18 +119,49 @@ fs::path self_executable() {
 
 pid_t spawn_exec(const std::vector<std::string>& argv_s, const ChildSetup& setup) {
   if (argv_s.empty()) throw ComputeError("cannot start a child process: empty command");
-  return spawn(
-      [&argv_s]() -> int {
-        std::vector<std::string> copy = argv_s;
-        std::vector<char*> argv;
-        for (auto& s : copy) argv.push_back(s.data());
-        argv.push_back(nullptr);
-        ::execvp(argv[0], argv.data());
-        std::fprintf(stderr, "cannot execute %s: %s\n", argv[0], std::strerror(errno));
-        std::fflush(nullptr);
-        ::_exit(127);
-      },
-      setup);
+  ExecArgs a(argv_s, setup.env);
+  ChildSetup without_env = setup;
+  without_env.env.clear();  // already in a.envp
+  return spawn_with_output([&a]() -> int { return exec_body(a); }, without_env, -1);
+}
+
+CapturedRun run_captured(const std::vector<std::string>& argv_s, const ChildSetup& setup) {
+  if (argv_s.empty()) throw ComputeError("cannot start a child process: empty command");
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw ComputeError(fmt::format("cannot start {}: pipe failed: {}", argv_s[0], std::strerror(errno)));
+  ExecArgs a(argv_s, setup.env);
+  ChildSetup without_env = setup;
+  without_env.env.clear();
+  const auto start = std::chrono::steady_clock::now();
+  pid_t pid = -1;
+  try {
+    pid = spawn_with_output([&a]() -> int { return exec_body(a); }, without_env, fds[1]);
+  } catch (...) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw;
+  }
+  ::close(fds[1]);
+  CapturedRun r;
+  char buf[4096];
+  for (;;) {
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n > 0) r.output.append(buf, static_cast<std::size_t>(n));
+    else if (n < 0 && errno == EINTR) continue;
+    else break;
+  }
+  ::close(fds[0]);
+  int status = 0;
+  rusage ru{};
+  while (::wait4(pid, &status, 0, &ru) < 0)
+    if (errno != EINTR) throw ComputeError(fmt::format("waiting for {} failed: {}", argv_s[0], std::strerror(errno)));
+  r.end = child_end(status, ru, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return r;
+}
+
+std::vector<std::pair<std::string, std::string>> single_thread_environment() {
+  return {{"OMP_NUM_THREADS", "1"}, {"OPENBLAS_NUM_THREADS", "1"}, {"VTK_SMP_BACKEND_IN_USE", "Sequential"},
+          {"VTK_SMP_MAX_THREADS", "1"}, {"STENTSIM_THREADS", "1"}};
 }
 
 std::string ChildEnd::describe() const {

@@ -1,14 +1,19 @@
 #pragma once
 // Child processes for every runner that starts them: the stage runner (a
-// stage run in a forked child), the error study (stentsim runs, under mpirun
-// for ranks > 1), the stability suite (cases under a wall-clock limit) and the
-// readers that hand a user's file to a library that may crash on it.
+// stage run in a forked child), the cohort pool (a `stentsim run` per case),
+// the Slurm follower (sbatch, squeue, sacct), the error study (stentsim runs,
+// under mpirun for ranks > 1), the stability suite (cases under a wall-clock
+// limit) and the readers that hand a user's file to a library that may crash
+// on it.
 // One implementation of the parts they share:
 //  - fork into a process group of its own (pgid = pid), so that a runner can
 //    stop a child and everything it started (mpirun's ranks, gmsh) with one
 //    kill(-pgid); the child dies with its parent (PR_SET_PDEATHSIG), so no
 //    orphan keeps working on (or locking) a folder;
-//  - stdout and stderr captured in a log file, environment set before exec;
+//  - the parent's stop handlers reset and SIGINT, SIGTERM, SIGCHLD unblocked
+//    in the child (common/stop_signals.hpp);
+//  - stdout and stderr captured in a log file (or returned: run_captured),
+//    environment set before exec;
 //  - exit status, CPU time and peak memory from wait4()'s rusage, which
 //    covers the child and its reaped descendants (ru_maxrss is the largest
 //    single process, not a sum: MPI runs report their ranks themselves);
@@ -43,10 +48,24 @@ pid_t spawn(const std::function<int()>& body, const ChildSetup& setup = {});
 /// child (an MPI run, a study's runs). Throws ComputeError when unknown.
 std::filesystem::path self_executable();
 
-/// Forks and executes argv (execvp: argv[0] is looked up in PATH unless it
-/// holds a '/'). Exit 127 when it cannot execute (the reason is in the log),
-/// 126 when the working folder cannot be entered.
+/// Forks and executes argv (execvpe: argv[0] is looked up in PATH unless it
+/// holds a '/'). Everything the child needs is built before the fork, so the
+/// child allocates nothing: safe from a multithreaded parent. Exit 127 when
+/// it cannot execute (the reason is in the log), 126 when the working folder
+/// cannot be entered.
 pid_t spawn_exec(const std::vector<std::string>& argv, const ChildSetup& setup = {});
+
+/// The environment variables that keep every library in a stentsim child to
+/// one thread, for runners whose children already fill the cores (a cohort's
+/// cases, a study's runs, counted by ranks). OMP_NUM_THREADS covers OpenMP
+/// (Kokkos/Trilinos, libgomp), OPENBLAS_NUM_THREADS OpenBLAS and
+/// STENTSIM_THREADS our own threaded assembly; VTK's SMP tools ignore them:
+/// Debian's VTK 9.1 runs vtkDiscreteFlyingEdges3D and
+/// vtkWindowedSincPolyDataFilter (label-image segmentation) on its TBB backend,
+/// which VTK_SMP_BACKEND_IN_USE=Sequential turns into one thread
+/// (VTK_SMP_MAX_THREADS=1 caps the others). gmsh is set to one thread in code
+/// (meshing/patient_mesh_gmsh.cpp).
+std::vector<std::pair<std::string, std::string>> single_thread_environment();
 
 /// How a child ended.
 struct ChildEnd {
@@ -59,6 +78,11 @@ struct ChildEnd {
   bool ok() const { return !timed_out && signal == 0 && exit_code == 0; }
   /// "exit status 3", "killed by signal 9 (Killed)", "timed out after 61 s".
   std::string describe() const;
+};
+
+struct CapturedRun {
+  ChildEnd end;
+  std::string output;  ///< stdout and stderr, interleaved as written
 };
 
 /// The ChildEnd of a reaped child from its wait status and rusage.
@@ -90,6 +114,12 @@ ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start,
 /// readers), where no check before them can see what they will trip on.
 void probe_read_in_child(const std::filesystem::path& file, const std::string& what, const std::function<void()>& read,
                          double limit_s = 20, double memory_bytes = 2.0 * 1024 * 1024 * 1024);
+
+/// Runs argv as spawn_exec does (setup.log is ignored), waits for it and
+/// returns its stdout and stderr together: for short commands whose answer
+/// the caller parses (sbatch, squeue). A stop signal does not cut the wait
+/// short (the command is in a group of its own, out of reach of a Ctrl-C).
+CapturedRun run_captured(const std::vector<std::string>& argv, const ChildSetup& setup = {});
 
 /// Sends `sig` to the child's process group and to every live descendant.
 void signal_family(pid_t pid, int sig);

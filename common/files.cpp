@@ -109,4 +109,14 @@ std::string content_hash(const fs::path& path) {
 
 std::string text_hash(const std::string& text) { return hex128(XXH3_128bits(text.data(), text.size())); }
 
+std::string log_tail(const fs::path& file, std::size_t n) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) lines.push_back(line);
+  std::string out;
+  for (std::size_t i = lines.size() > n ? lines.size() - n : 0; i < lines.size(); ++i) out += (out.empty() ? "" : " | ") + lines[i];
+  return out;
+}
+
 }  // namespace stentsim::files

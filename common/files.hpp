@@ -33,4 +33,9 @@ std::string content_hash(const std::filesystem::path& path);
 /// 128-bit xxHash (XXH3) of a string, 32 hex digits.
 std::string text_hash(const std::string& text);
 
+/// The last `n` non-empty lines of a text file (a child's log) joined by " | ",
+/// for a one-line failure message; empty when the file is missing, unreadable
+/// or blank.
+std::string log_tail(const std::filesystem::path& file, std::size_t n);
+
 }  // namespace stentsim::files

@@ -10,13 +10,13 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <map>
 #include <ostream>
 #include <set>
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/stop_signals.hpp"
 #include "pipeline/stage_process.hpp"
 #include "pipeline/staleness.hpp"
 #include "pipeline/work_lock.hpp"
@@ -25,30 +25,6 @@ namespace fs = std::filesystem;
 
 namespace stentsim::pipeline {
 namespace {
-
-volatile std::sig_atomic_t g_stop_signal = 0;
-extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
-
-/// Installs SIGINT/SIGTERM handlers for the duration of a run (no SA_RESTART,
-/// so a blocking wait returns EINTR and the runner can stop its children).
-class StopSignals {
- public:
-  StopSignals() {
-    g_stop_signal = 0;
-    struct sigaction sa {};
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-
- private:
-  struct sigaction old_int_ {}, old_term_ {};
-};
 
 struct Running {
   std::size_t stage;
@@ -141,7 +117,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
                                        stages[i].name, o, stages[u].name));
   }
 
-  StopSignals signals;
+  process::StopSignals signals;  // a stop ends the stages with SIGTERM, keeps what finished
   std::set<std::size_t> done, blocked;
   std::map<pid_t, Running> running;
   const int jobs = std::max(1, options.jobs);
@@ -187,7 +163,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
     // touched. A finished run of the stage replaces what an earlier one kept.
     const fs::path kept = plan_.work_dir() / "failed" / s.name;
     bool kept_partial = false;
-    if (!o.interrupted && !g_stop_signal) {
+    if (!o.interrupted && !process::StopSignals::received()) {
       std::error_code ec;
       fs::remove_all(kept, ec);
       if (!o.ok && fs::exists(r.temp_dir) && !fs::is_empty(r.temp_dir)) {
@@ -215,7 +191,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       done.insert(r.stage);
       report.ran.push_back(s.name);
       out << fmt::format("  done  {:<13} {:.2f} s, {:.0f} MB\n", s.name, dt, o.peak_memory_mb);
-    } else if (o.interrupted || g_stop_signal) {
+    } else if (o.interrupted || process::StopSignals::received()) {
       report.interrupted = true;
       out << fmt::format("  stop  {:<13} interrupted; earlier artifacts kept\n", s.name);
     } else {
@@ -244,7 +220,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
 
   while (true) {
     // Launch every ready stage while there is room and no stop or failure.
-    for (auto it = pending.begin(); !failing && !g_stop_signal && it != pending.end() && static_cast<int>(running.size()) < jobs;) {
+    for (auto it = pending.begin(); !failing && !process::StopSignals::received() && it != pending.end() && static_cast<int>(running.size()) < jobs;) {
       const std::size_t i = *it;
       const auto& up = plan_.upstream(i);
       const auto bad = std::find_if(up.begin(), up.end(), [&](std::size_t u) { return unusable.count(u) > 0; });
@@ -289,7 +265,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       it = pending.begin();
     }
     if (running.empty()) break;
-    if (g_stop_signal)
+    if (process::StopSignals::received())
       for (const auto& [p, r] : running) ::kill(-p, SIGTERM);  // the stage's process group
     int wstatus = 0;
     rusage ru{};
@@ -316,7 +292,7 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
       throw ComputeError(fmt::format("stage {}: {}", finished_name, e.what()));
     }
   }
-  if (g_stop_signal) report.interrupted = true;
+  if (process::StopSignals::received()) report.interrupted = true;
   std::error_code ec;
   fs::remove(plan_.work_dir() / ".tmp", ec);  // only if empty
   return report;

@@ -104,3 +104,29 @@ TEST(PipelineChildProcess, BodyRunsInItsOwnProcessGroup) {
   EXPECT_THROW(spawn_exec({}), stentsim::ComputeError);
   fs::remove_all(d);
 }
+
+TEST(PipelineChildProcess, EnvironmentOverridesReplaceTheParentsValue) {
+  const fs::path d = fresh_dir("env");
+  ::setenv("STENTSIM_CHILD_OLD", "parent", 1);
+  ChildSetup s;
+  s.log = d / "log";
+  s.env = {{"STENTSIM_CHILD_OLD", "child"}};
+  // sh found through PATH (execvpe), one entry for the variable, the child's value.
+  const ChildEnd e = run({"sh", "-c", "env | grep -c '^STENTSIM_CHILD_OLD='; echo $STENTSIM_CHILD_OLD"}, s);
+  EXPECT_TRUE(e.ok()) << e.describe();
+  EXPECT_EQ(read(s.log), "1\nchild\n");
+  ::unsetenv("STENTSIM_CHILD_OLD");
+  fs::remove_all(d);
+}
+
+TEST(PipelineChildProcess, RunCapturedReturnsBothStreamsAndTheStatus) {
+  ChildSetup s;
+  s.env = {{"STENTSIM_CHILD_TEST", "seen"}};
+  const CapturedRun r = run_captured({"/bin/sh", "-c", "echo out $STENTSIM_CHILD_TEST; echo err >&2; exit 4"}, s);
+  EXPECT_EQ(r.end.exit_code, 4);
+  EXPECT_EQ(r.output, "out seen\nerr\n");
+  const CapturedRun missing = run_captured({"/nonexistent/squeue"});
+  EXPECT_EQ(missing.end.exit_code, 127);
+  EXPECT_NE(missing.output.find("cannot execute /nonexistent/squeue"), std::string::npos) << missing.output;
+  EXPECT_THROW(run_captured({}), stentsim::ComputeError);
+}

@@ -87,3 +87,13 @@ TEST(Files, SummaryWithoutSetRunReportsThisProcess) {
   EXPECT_GT(r.peak_memory_mb(), 30.0);
   fs::remove(f);
 }
+
+TEST(Files, LogTailKeepsTheLastNonEmptyLines) {
+  const fs::path f = fs::temp_directory_path() / ("stentsim-log-tail-" + std::to_string(::getpid()) + ".log");
+  stentsim::files::write_atomic(f, "one\n\ntwo\nthree\n\n");
+  EXPECT_EQ(stentsim::files::log_tail(f, 2), "two | three");
+  EXPECT_EQ(stentsim::files::log_tail(f, 10), "one | two | three");
+  EXPECT_EQ(stentsim::files::log_tail(f, 0), "");
+  fs::remove(f);
+  EXPECT_EQ(stentsim::files::log_tail(f, 3), "");  // missing: no text to quote
+}

@@ -2,9 +2,13 @@
 // The mutations every reader fuzz test applies to copies of valid files, and
 // the loop that judges each mutant: it must either read (a valid input) or
 // fail with an InputError naming the file; a crash, a hang, std::bad_alloc or
-// any other exception fails the test. A fixed seed; 300 mutants per format in
+// any other exception fails the test, as does a read that takes more than
+// seconds_allowed() or raises the process's peak resident memory above what it
+// held when judging began plus megabytes_allowed(). A fixed seed; 300 mutants per format in
 // the quick set, STENTSIM_FUZZ_ITERATIONS more (the validation variants).
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -34,6 +38,27 @@ inline int iterations() {
 inline double seconds_allowed() {
   const char* s = std::getenv("STENTSIM_FUZZ_SECONDS");
   return s ? std::max(1.0, std::atof(s)) : 30.0;
+}
+
+/// The memory a read may add (issue 22: 2 GB for any input under 10 MB);
+/// STENTSIM_FUZZ_MEGABYTES raises it for instrumented builds.
+inline double megabytes_allowed() {
+  const char* s = std::getenv("STENTSIM_FUZZ_MEGABYTES");
+  return s ? std::max(1.0, std::atof(s)) : 2048.0;
+}
+
+/// This process's resident memory now and its peak so far, in MB (Linux: statm, ru_maxrss).
+inline double resident_megabytes() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  unsigned long size = 0, resident = 0;
+  const bool ok = f && std::fscanf(f, "%lu %lu", &size, &resident) == 2;
+  if (f) std::fclose(f);
+  return ok ? static_cast<double>(resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) / 1048576.0 : 0.0;
+}
+inline double peak_resident_megabytes() {
+  rusage ru{};
+  ::getrusage(RUSAGE_SELF, &ru);
+  return static_cast<double>(ru.ru_maxrss) / 1024.0;  // kB on Linux
 }
 
 /// One mutation of `seed`: a few bit flips, a byte run inserted or deleted, a cut,
@@ -92,11 +117,14 @@ struct Tally {
 };
 
 /// Runs `read` on n mutants that `make(i)` writes (returning the file the error
-/// must name); counts valid reads and input errors, fails on anything else and on
-/// a mutant that takes longer than seconds_allowed() (a clear error must come within that).
+/// must name); counts valid reads and input errors, fails on anything else, on
+/// a mutant that takes longer than seconds_allowed() (a clear error must come within that)
+/// and on one that takes the peak resident memory above the start's plus megabytes_allowed().
+/// (The peak never falls, so the bound holds for every mutant judged so far.)
 inline Tally judge(const std::string& format, int n, const std::function<std::filesystem::path(int)>& make,
                    const std::function<void(const std::filesystem::path&)>& read) {
   Tally t;
+  const double memory_bound = resident_megabytes() + megabytes_allowed();
   for (int i = 0; i < n; ++i) {
     const std::filesystem::path named = make(i);
     const auto start = std::chrono::steady_clock::now();
@@ -112,9 +140,12 @@ inline Tally judge(const std::string& format, int n, const std::function<std::fi
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_LT(seconds, seconds_allowed()) << format << " mutant " << i << " took " << seconds << " s";
+    const double peak = peak_resident_megabytes();
+    EXPECT_LT(peak, memory_bound) << format << " mutant " << i << ": peak resident memory " << peak << " MB" << keep(named);
     if (::testing::Test::HasFatalFailure()) return t;
   }
-  std::printf("%-16s %d mutants: %d read, %d refused with an input error\n", format.c_str(), n, t.read, t.refused);
+  std::printf("%-16s %d mutants: %d read, %d refused with an input error; peak resident memory %.0f MB (bound %.0f)\n",
+              format.c_str(), n, t.read, t.refused, peak_resident_megabytes(), memory_bound);
   std::fflush(stdout);
   return t;
 }

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <string>
 
+#include "common/child_process.hpp"
 #include "common/files.hpp"
 #include "tests/workflows/cli_runner.hpp"
 #include "workflows/cohort/cohort_plots.hpp"
@@ -502,7 +503,7 @@ TEST_F(Cohort, LocalWorkersRunWithOneThreadPerLibrary) {
     EXPECT_NE(env.find("\nSTENTSIM_THREADS=1\n"), std::string::npos) << env;  // the solver's element loops
     EXPECT_NE(env.find("\nHOME="), std::string::npos) << env;  // the rest of the environment is kept
   }
-  const auto single = single_thread_environment();
+  const auto single = stentsim::process::single_thread_environment();
   EXPECT_NE(std::find(single.begin(), single.end(), std::make_pair(std::string("VTK_SMP_BACKEND_IN_USE"), std::string("Sequential"))),
             single.end());
 }

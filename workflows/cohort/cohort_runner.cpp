@@ -1,9 +1,7 @@
 #include "workflows/cohort/cohort_runner.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
-#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/wait.h>
@@ -21,8 +19,10 @@
 #include <set>
 #include <thread>
 
+#include "common/child_process.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/stop_signals.hpp"
 #include "common/summary.hpp"
 #include "pipeline/manifest.hpp"
 #include "workflows/case_stages.hpp"
@@ -33,63 +33,6 @@ namespace fs = std::filesystem;
 namespace stentsim::workflows {
 namespace {
 
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_cohort_stop(int sig) { g_stop = sig; }
-extern "C" void on_cohort_child(int) {}  // only wakes sigsuspend
-
-/// While the pool runs, SIGINT, SIGTERM and SIGCHLD are blocked except inside
-/// sigsuspend: a stop signal can then never fall between the check of the stop
-/// flag and the wait (it used to be lost there, and the pool waited for every
-/// running case to end on its own), nor between fork and the registration of
-/// the new worker. Restores handlers and mask on every way out.
-class PoolSignals {
- public:
-  PoolSignals() {
-    g_stop = 0;
-    sigset_t block;
-    sigemptyset(&block);
-    for (int s : {SIGINT, SIGTERM, SIGCHLD}) sigaddset(&block, s);
-    sigprocmask(SIG_BLOCK, &block, &old_mask_);
-    wait_mask_ = old_mask_;
-    for (int s : {SIGINT, SIGTERM, SIGCHLD}) sigdelset(&wait_mask_, s);
-    struct sigaction sa {};
-    sigemptyset(&sa.sa_mask);
-    sa.sa_handler = on_cohort_stop;
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-    sa.sa_handler = on_cohort_child;
-    sa.sa_flags = SA_NOCLDSTOP;
-    sigaction(SIGCHLD, &sa, &old_chld_);
-  }
-  ~PoolSignals() {
-    // Unblock first, with our handlers still in place: a stop signal that
-    // arrived after the last wait sets the flag instead of killing the process.
-    sigprocmask(SIG_SETMASK, &old_mask_, nullptr);
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-    sigaction(SIGCHLD, &old_chld_, nullptr);
-  }
-  /// Sleeps until a signal arrives (a worker ended, or a stop).
-  void wait() const { sigsuspend(&wait_mask_); }
-  /// The mask a worker starts with (the caller's, before the pool blocked).
-  const sigset_t& worker_mask() const { return old_mask_; }
-
- private:
-  sigset_t old_mask_{}, wait_mask_{};
-  struct sigaction old_int_ {}, old_term_ {}, old_chld_ {};
-};
-
-std::string tail_lines(const fs::path& file, int n) {
-  std::ifstream in(file);
-  std::vector<std::string> lines;
-  std::string line;
-  while (std::getline(in, line)) lines.push_back(line);
-  std::string out;
-  for (std::size_t i = lines.size() > static_cast<std::size_t>(n) ? lines.size() - static_cast<std::size_t>(n) : 0; i < lines.size(); ++i)
-    out += (out.empty() ? "" : " | ") + lines[i];
-  return out;
-}
-
 // What a failed run's log says went wrong: its last "error: " line (the runner's own,
 // naming the stage and its error), without the prefix; else the log's last lines.
 std::string failure_message(const fs::path& log) {
@@ -97,7 +40,7 @@ std::string failure_message(const fs::path& log) {
   std::string line, error;
   while (std::getline(in, line))
     if (line.rfind("error: ", 0) == 0) error = line.substr(7);
-  return error.empty() ? tail_lines(log, 3) : error;
+  return error.empty() ? files::log_tail(log, 3) : error;
 }
 
 // The first failed stage in the case's manifest, or none.
@@ -129,53 +72,17 @@ bool stage_succeeded(const fs::path& manifest_file, const std::string& stage) {
   return rec && rec->status == "ok";
 }
 
-// Called with SIGINT/SIGTERM/SIGCHLD blocked (PoolSignals): the child resets
-// the handlers to their defaults before it unblocks, so a Ctrl-C that reached
-// it between fork and exec ends it instead of setting a flag nobody reads.
-pid_t start_case(const std::string& binary, const fs::path& case_file, const std::vector<std::string>& args, const fs::path& log,
-                 const sigset_t& worker_mask) {
-  std::vector<std::string> argv_s = {binary, "run", case_file.string()};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  fs::create_directories(log.parent_path());
-  std::vector<char*> argv;  // built before fork: the child only calls async-signal-safe functions
-  for (auto& s : argv_s) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  // The worker's environment: ours, with one thread per library inside a cohort.
-  const auto single = single_thread_environment();
-  std::vector<std::string> env_s;
-  for (char** e = environ; *e; ++e) {
-    const std::string kv = *e;
-    const std::string key = kv.substr(0, kv.find('='));
-    if (std::none_of(single.begin(), single.end(), [&](const auto& p) { return p.first == key; })) env_s.push_back(kv);
-  }
-  for (const auto& [k, v] : single) env_s.push_back(k + "=" + v);
-  std::vector<char*> envp;
-  for (auto& s : env_s) envp.push_back(s.data());
-  envp.push_back(nullptr);
-  const pid_t parent = ::getpid();
-  std::fflush(nullptr);
-  pid_t pid = ::fork();
-  if (pid < 0) throw ComputeError(fmt::format("cohort: fork failed: {}", std::strerror(errno)));
-  if (pid == 0) {
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGTERM, SIG_DFL);
-    ::signal(SIGCHLD, SIG_DFL);
-    // A worker dies with the pool (SIGTERM: its runner stops its stage and
-    // keeps earlier artifacts), so a killed `cohort run` leaves no orphans.
-    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (::getppid() != parent) ::_exit(130);
-    int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      ::close(fd);
-    }
-    sigprocmask(SIG_SETMASK, &worker_mask, nullptr);
-    ::execve(binary.c_str(), argv.data(), envp.data());
-    std::perror("cohort: exec of stentsim failed");
-    ::_exit(127);
-  }
-  return pid;
+// A case's `stentsim run`, one thread per library (the cohort's cores go to
+// parallel cases). It sits in a process group of its own and dies with the
+// pool (PR_SET_PDEATHSIG: its runner stops its stage and keeps earlier
+// artifacts), so a killed `cohort run` leaves no orphans.
+pid_t start_case(const std::string& binary, const fs::path& case_file, const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> argv = {binary, "run", case_file.string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  process::ChildSetup setup;
+  setup.log = log;
+  setup.env = process::single_thread_environment();
+  return process::spawn_exec(argv, setup);
 }
 
 const char* const kStartup = "(case start-up)";
@@ -250,11 +157,6 @@ std::vector<std::size_t> selected_cases(const CohortConfig& c, const std::vector
   for (std::size_t i = 0; i < c.cases.size(); ++i)
     if (only.empty() || std::count(only.begin(), only.end(), c.cases[i].id)) todo.push_back(i);
   return todo;
-}
-
-std::vector<std::pair<std::string, std::string>> single_thread_environment() {
-  return {{"OMP_NUM_THREADS", "1"}, {"OPENBLAS_NUM_THREADS", "1"}, {"VTK_SMP_BACKEND_IN_USE", "Sequential"},
-          {"VTK_SMP_MAX_THREADS", "1"}, {"STENTSIM_THREADS", "1"}};
 }
 
 int concurrent_cases(int workers, int ranks_per_case, int cores) {
@@ -345,20 +247,23 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
   std::size_t next = 0;
   bool stopping = false;
   {
-    PoolSignals signals;
+    // Signals blocked except while the pool sleeps: a stop can fall neither
+    // between the flag's check and the sleep nor between a fork and the
+    // registration of its worker.
+    process::StopSignals signals(process::StopSignals::Mode::wait_for_signal);
     while (true) {
-      while (!g_stop && next < todo.size() && static_cast<int>(running.size()) < slots) {
+      while (!process::StopSignals::received() && next < todo.size() && static_cast<int>(running.size()) < slots) {
         const std::size_t i = todo[next++];
         const fs::path dir = c.work_dir / c.cases[i].id;
-        const pid_t pid = start_case(o.binary, case_files[i], o.run_args, dir / "run.log", signals.worker_mask());
+        const pid_t pid = start_case(o.binary, case_files[i], o.run_args, dir / "run.log");
         running[pid] = {i, std::chrono::steady_clock::now()};  // still blocked: no signal in between
       }
       if (running.empty()) break;
-      if (g_stop && !stopping) {
+      if (process::StopSignals::received() && !stopping) {
         stopping = true;
         out << fmt::format("stopping: {} running case(s) get SIGTERM (their runners keep finished stages)\n", running.size());
         out.flush();
-        for (auto& [p, r] : running) ::kill(p, SIGTERM);
+        for (auto& [p, r] : running) ::kill(-p, SIGTERM);  // the worker's group
       }
       int status = 0;
       const pid_t pid = ::waitpid(-1, &status, WNOHANG);
@@ -404,7 +309,7 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
   CohortReport rep;
   rep.cases = done;
   sort_like_cohort(c, rep.cases);
-  if (g_stop) throw Interrupted();
+  if (process::StopSignals::received()) throw Interrupted();
   return rep;
 }
 

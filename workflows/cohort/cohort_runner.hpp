@@ -55,16 +55,6 @@ std::vector<std::size_t> selected_cases(const CohortConfig& c, const std::vector
 /// Orders outcomes as the cases appear in the cohort file.
 void sort_like_cohort(const CohortConfig& c, std::vector<CaseOutcome>& cases);
 
-/// The environment variables that keep every library to one thread inside a
-/// cohort (issue 10: "one thread for the libraries"): cases already use every
-/// core. OMP_NUM_THREADS covers OpenMP (Kokkos/Trilinos, libgomp) and OpenBLAS;
-/// VTK's SMP tools ignore it: Debian's VTK 9.1 runs vtkDiscreteFlyingEdges3D
-/// and vtkWindowedSincPolyDataFilter (label-image segmentation) on its TBB
-/// backend, which VTK_SMP_BACKEND_IN_USE=Sequential turns into one thread
-/// (VTK_SMP_MAX_THREADS=1 caps the others). gmsh is set to one thread in code
-/// (meshing/patient_mesh_gmsh.cpp); our code calls no TBB directly. Used by
-/// the local workers and exported by the Slurm task script.
-std::vector<std::pair<std::string, std::string>> single_thread_environment();
 
 /// Concurrent cases: min(workers, cores / ranks_per_case), at least 1.
 int concurrent_cases(int workers, int ranks_per_case, int cores);

@@ -1,16 +1,12 @@
 #include "workflows/cohort/cohort_slurm.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -21,7 +17,9 @@
 #include <sstream>
 #include <thread>
 
+#include "common/child_process.hpp"
 #include "common/error.hpp"
+#include "common/stop_signals.hpp"
 #include "common/files.hpp"
 #include "pipeline/manifest.hpp"
 #include "pipeline/runner.hpp"
@@ -33,9 +31,6 @@ namespace fs = std::filesystem;
 
 namespace stentsim::workflows {
 namespace {
-
-volatile std::sig_atomic_t g_slurm_stop = 0;
-extern "C" void on_slurm_stop(int sig) { g_slurm_stop = sig; }
 
 const char* const kLost = "failed (lost: time, memory or node)";
 
@@ -61,40 +56,11 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs a program (no shell) and captures its output.
-CommandResult run_command(const std::vector<std::string>& argv_s) {
-  int fds[2];
-  if (::pipe(fds) != 0) throw ComputeError("cohort (slurm): pipe failed");
-  const pid_t pid = ::fork();
-  if (pid < 0) throw ComputeError("cohort (slurm): fork failed");
-  if (pid == 0) {
-    ::signal(SIGINT, SIG_IGN);  // the parent decides what a Ctrl-C cancels
-    ::dup2(fds[1], 1);
-    ::dup2(fds[1], 2);
-    ::close(fds[0]);
-    ::close(fds[1]);
-    std::vector<char*> argv;
-    for (const auto& s : argv_s) argv.push_back(::strdup(s.c_str()));
-    argv.push_back(nullptr);
-    ::execvp(argv[0], argv.data());
-    std::perror(argv_s[0].c_str());
-    ::_exit(127);
-  }
-  ::close(fds[1]);
-  CommandResult r;
-  char buf[4096];
-  for (;;) {
-    const ssize_t n = ::read(fds[0], buf, sizeof buf);
-    if (n > 0) r.output.append(buf, static_cast<std::size_t>(n));
-    else if (n < 0 && errno == EINTR) continue;
-    else break;
-  }
-  ::close(fds[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return r;
+// Runs a Slurm command (no shell) and captures its output; code is the exit
+// status, 128 + the signal that ended it.
+CommandResult run_command(const std::vector<std::string>& argv) {
+  const auto run = process::run_captured(argv);
+  return {run.end.signal ? 128 + run.end.signal : run.end.exit_code, run.output};
 }
 
 std::string trim(std::string s) {
@@ -102,15 +68,10 @@ std::string trim(std::string s) {
   return s;
 }
 
-std::string tail_of(const fs::path& file, int n) {
-  std::ifstream in(file);
-  if (!in) return "(no Slurm output file " + file.string() + ")";
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  std::string out;
-  const std::size_t from = lines.size() > static_cast<std::size_t>(n) ? lines.size() - static_cast<std::size_t>(n) : 0;
-  for (std::size_t i = from; i < lines.size(); ++i) out += (out.empty() ? "" : " | ") + lines[i];
-  return out.empty() ? "(empty Slurm output " + file.string() + ")" : out;
+std::string tail_of(const fs::path& file, std::size_t n) {
+  if (!fs::exists(file)) return "(no Slurm output file " + file.string() + ")";
+  const std::string tail = files::log_tail(file, n);
+  return tail.empty() ? "(empty Slurm output " + file.string() + ")" : tail;
 }
 
 // States in which a job still holds (or waits for) resources.
@@ -148,7 +109,7 @@ void cancel(const std::vector<std::string>& tasks, std::ostream& out) {
 
 void sleep_interruptibly(double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!g_slurm_stop && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  while (!process::StopSignals::received() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(50));
 }
 
 // ---- the cohort manifest: which Slurm task ran (or runs) each case -------
@@ -295,7 +256,7 @@ void probe(const CohortConfig& c, const std::string& binary, std::ostream& out) 
   out.flush();
   std::string state, exit_code;
   for (;;) {
-    if (g_slurm_stop) {
+    if (process::StopSignals::received()) {
       cancel({job}, out);
       throw Interrupted();
     }
@@ -344,7 +305,7 @@ std::string slurm_array_script(const CohortConfig& c, const std::vector<std::str
                 std::to_string(c.ranks_per_case) + "}\"\n"
           : "";
   std::string threads;  // one thread per library, as for the local workers
-  for (const auto& [k, v] : single_thread_environment()) threads += "export " + k + "=" + sh_quote(v) + "\n";
+  for (const auto& [k, v] : process::single_thread_environment()) threads += "export " + k + "=" + sh_quote(v) + "\n";
   // The exit-code file ("<rc> <task id>", temp + rename) is the task's last
   // act: its absence after the task left the queue means the task was lost.
   return fmt::format(
@@ -488,19 +449,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
     return rep;
   }
 
-  struct sigaction sa {}, old_int {}, old_term {};
-  sa.sa_handler = on_slurm_stop;
-  sigemptyset(&sa.sa_mask);
-  g_slurm_stop = 0;
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
-  struct Restore {
-    struct sigaction *i, *t;
-    ~Restore() {
-      sigaction(SIGINT, i, nullptr);
-      sigaction(SIGTERM, t, nullptr);
-    }
-  } restore{&old_int, &old_term};
+  process::StopSignals signals;  // a Ctrl-C cancels what this run submitted
 
   struct Follow {
     std::size_t index;
@@ -570,7 +519,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
   }
 
   CohortReport rep;
-  if (o.no_wait && g_slurm_stop) {  // Ctrl-C while submitting: take back what was submitted
+  if (o.no_wait && process::StopSignals::received()) {  // Ctrl-C while submitting: take back what was submitted
     cancel(active_tasks(), out);
     throw Interrupted();
   }
@@ -589,7 +538,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
   const double grace = std::max(2.0, 3 * c.slurm.poll_interval_s);
   std::string last_line;
   try {
-    while (!g_slurm_stop && std::any_of(follow.begin(), follow.end(), [](const Follow& f) { return !f.finished; })) {
+    while (!process::StopSignals::received() && std::any_of(follow.begin(), follow.end(), [](const Follow& f) { return !f.finished; })) {
       std::set<std::string> live;
       for (const auto& f : follow)
         if (!f.finished) live.insert(tasks.at(c.cases[f.index].id).array);
@@ -646,7 +595,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
     cancel(active_tasks(), out);
     throw;
   }
-  if (g_slurm_stop) {
+  if (process::StopSignals::received()) {
     const auto ids = active_tasks();
     cancel(ids, out);
     // Wait (bounded) until the cancelled tasks have left the active states.

@@ -8,7 +8,6 @@
 
 #include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -19,6 +18,7 @@
 #include "common/files.hpp"
 #include "common/summary.hpp"
 #include "common/child_process.hpp"
+#include "common/stop_signals.hpp"
 #include "workflows/version.hpp"
 
 namespace fs = std::filesystem;
@@ -26,26 +26,13 @@ namespace fs = std::filesystem;
 namespace stentsim::study {
 namespace {
 
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_study_stop(int sig) { g_stop = sig; }
-
-std::string tail_lines(const fs::path& file, std::size_t n) {
-  std::ifstream in(file);
-  std::vector<std::string> lines;
-  std::string line;
-  while (std::getline(in, line))
-    if (!line.empty()) lines.push_back(line);
-  std::string out;
-  for (std::size_t i = lines.size() > n ? lines.size() - n : 0; i < lines.size(); ++i) out += (out.empty() ? "" : " | ") + lines[i];
-  return out;
-}
-
 pid_t start_child(const std::vector<std::string>& args, const fs::path& log) {
   process::ChildSetup setup;
   setup.log = log;
   setup.append_log = true;  // the run's commands share run.log
   // One thread per rank: the core budget counts ranks.
-  setup.env = {{"OMP_NUM_THREADS", "1"}, {"STENTSIM_THREADS", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"}};
+  setup.env = process::single_thread_environment();
+  setup.env.insert(setup.env.end(), {{"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"}});
   return process::spawn_exec(args, setup);
 }
 
@@ -173,17 +160,8 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
   int ranks_in_flight = 0;
   std::size_t next = 0;
 
-  struct sigaction sa {}, old_int{}, old_term{};
-  sa.sa_handler = on_study_stop;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;  // no SA_RESTART: wait4 returns EINTR on Ctrl-C
-  g_stop = 0;
-  ::sigaction(SIGINT, &sa, &old_int);
-  ::sigaction(SIGTERM, &sa, &old_term);
-  auto restore = [&] {
-    ::sigaction(SIGINT, &old_int, nullptr);
-    ::sigaction(SIGTERM, &old_term, nullptr);
-  };
+  // A stop ends the running runs (SIGTERM to their groups); finished runs keep their results.
+  process::StopSignals signals;
 
   auto finish = [&](Running& r, bool ok, const std::string& why) {
     const RunSpec& spec = plan.runs[r.run];
@@ -216,7 +194,7 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
 
   try {
     while (next < todo.size() || !running.empty()) {
-      if (g_stop) throw Interrupted();
+      if (process::StopSignals::received()) throw Interrupted();
       // Start runs while a slot and enough cores are free (in plan order:
       // a big run waits for cores rather than being overtaken forever).
       while (next < todo.size() && static_cast<int>(running.size()) < jobs &&
@@ -265,7 +243,7 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
       std::string why;
       if (!ok) {
         why = end.describe();
-        const std::string tail = tail_lines(dir / "run.log", 2);
+        const std::string tail = files::log_tail(dir / "run.log", 2);
         if (!tail.empty()) why += ": " + tail;
       }
       Running done = std::move(r);
@@ -278,10 +256,8 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
       int st = 0;
       ::waitpid(pid, &st, 0);
     }
-    restore();
     throw;
   }
-  restore();
   return stats;
 }
 
