@@ -6,10 +6,12 @@
 #include <exception>
 
 #include "common/error.hpp"
+#include "common/heap_policy.hpp"
 #include "workflows/cli/commands.hpp"
 #include "workflows/version.hpp"
 
 int main(int argc, char** argv) {
+  stentsim::heap::keep_large_blocks();  // factorizations reuse freed pages (common/heap_policy.hpp)
   CLI::App app{"stentsim: patient-specific simulation of balloon angioplasty with stent implantation"};
   app.set_version_flag("--version", std::string(stentsim::kVersion));
   app.require_subcommand(1);
