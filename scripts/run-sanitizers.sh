@@ -32,6 +32,10 @@ export VTK_SMP_BACKEND_IN_USE=Sequential
 # zlib .vtu mutant whose blocks claim gigabytes took 36 s (read twice: the probe child,
 # then the reader) with the other core busy; the release build reads all 1,200 in 41 s.
 export STENTSIM_FUZZ_SECONDS=90
+# The fuzz tests' memory bound (2 GB over the start, the release build's) plus a GB: ASan's
+# allocator keeps up to 256 MB of freed blocks in quarantine, adds redzones to every block
+# and its shadow memory grows with what the reader touches.
+export STENTSIM_FUZZ_MEGABYTES=3072
 export ASAN_OPTIONS="exitcode=86:max_allocation_size_mb=4096:allocator_may_return_null=1:detect_leaks=1:abort_on_error=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:exitcode=86"
 export LSAN_OPTIONS="suppressions=$here/scripts/lsan-suppressions.txt:print_suppressions=0"
