@@ -24,23 +24,30 @@ namespace {
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
 
-/// The child's part of spawn(): group, signals, parent link, folder, output,
-/// environment. Only async-signal-safe calls, except setenv for a
+/// The child's part of spawn(): signals, group, parent link, folder, input,
+/// output, environment. Only async-signal-safe calls, except setenv for a
 /// setup.env that spawn_exec has not already folded into its envp.
-void set_up_child(const ChildSetup& s, pid_t parent, int output_fd) {
+void set_up_child(const ChildSetup& s, pid_t parent, int output_fd, const sigset_t& parent_mask) {
+  // The stop signals were blocked across the fork, so none reached the
+  // parent's handlers in this process: default actions first, then the
+  // parent's mask without them (a parent in StopSignals::Mode::wait_for_signal
+  // keeps them blocked outside its waits; the child must not).
   ::signal(SIGINT, SIG_DFL);
   ::signal(SIGTERM, SIG_DFL);
   ::signal(SIGCHLD, SIG_DFL);
-  // A parent in StopSignals::Mode::wait_for_signal has these blocked; the
-  // child starts with them deliverable, so a stop reaches it.
-  sigset_t stop;
-  sigemptyset(&stop);
-  for (int sig : {SIGINT, SIGTERM, SIGCHLD}) sigaddset(&stop, sig);
-  ::sigprocmask(SIG_UNBLOCK, &stop, nullptr);
+  sigset_t mask = parent_mask;
+  for (int sig : {SIGINT, SIGTERM, SIGCHLD}) sigdelset(&mask, sig);
+  ::pthread_sigmask(SIG_SETMASK, &mask, nullptr);
   ::setpgid(0, 0);
   ::prctl(PR_SET_PDEATHSIG, SIGTERM);
   if (::getppid() != parent) ::_exit(1);  // the parent died before prctl took effect
   if (!s.cwd.empty() && ::chdir(s.cwd.c_str()) != 0) ::_exit(126);
+  // No terminal input: a child in a background process group of its own that
+  // read the terminal would be stopped (SIGTTIN), and its parent wait forever.
+  if (const int in = ::open("/dev/null", O_RDONLY); in >= 0) {
+    ::dup2(in, 0);
+    if (in > 0) ::close(in);
+  }
   int fd = output_fd;
   if (fd < 0 && !s.log.empty()) fd = ::open(s.log.c_str(), O_WRONLY | O_CREAT | (s.append_log ? O_APPEND : O_TRUNC), 0644);
   if (fd >= 0) {
@@ -55,10 +62,17 @@ pid_t spawn_with_output(const std::function<int()>& body, const ChildSetup& setu
   if (output_fd < 0 && !setup.log.empty() && setup.log.has_parent_path()) fs::create_directories(setup.log.parent_path());
   std::fflush(nullptr);  // nothing buffered is written twice
   const pid_t parent = ::getpid();
+  // A stop signal sent to the new child between fork and its reset of the
+  // handlers would only set the flag of the parent's handler copy: blocked
+  // across the fork, it stays pending in the child until the handlers are the
+  // defaults.
+  sigset_t stop, old_mask;
+  sigemptyset(&stop);
+  for (int sig : {SIGINT, SIGTERM, SIGCHLD}) sigaddset(&stop, sig);
+  ::pthread_sigmask(SIG_BLOCK, &stop, &old_mask);
   const pid_t pid = ::fork();
-  if (pid < 0) throw ComputeError(fmt::format("cannot start a child process: fork failed: {}", std::strerror(errno)));
   if (pid == 0) {
-    set_up_child(setup, parent, output_fd);
+    set_up_child(setup, parent, output_fd, old_mask);
     int code = 1;
     try {
       code = body();
@@ -70,7 +84,10 @@ pid_t spawn_with_output(const std::function<int()>& body, const ChildSetup& setu
     std::fflush(nullptr);
     ::_exit(code);  // no atexit handlers, no static destructors of the parent's objects
   }
-  ::setpgid(pid, pid);  // also here: no race with a stop signal sent right after fork
+  const int fork_errno = errno;
+  if (pid > 0) ::setpgid(pid, pid);  // also here: no race with a stop signal sent right after fork
+  ::pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+  if (pid < 0) throw ComputeError(fmt::format("cannot start a child process: fork failed: {}", std::strerror(fork_errno)));
   return pid;
 }
 
@@ -99,7 +116,8 @@ struct ExecArgs {
 /// The exec body of spawn_exec and run_captured: exit 127 when it cannot execute.
 int exec_body(ExecArgs& a) {
   ::execvpe(a.argv[0], a.argv.data(), a.envp.data());
-  const char* why = std::strerror(errno);  // glibc's table: no allocation
+  const char* why = ::strerrordesc_np(errno);  // a static English text: no locale, no allocation
+  if (!why) why = "unknown error";
   for (const char* part : {"cannot execute ", static_cast<const char*>(a.argv[0]), ": ", why, "\n"})
     if (::write(2, part, std::strlen(part)) < 0) break;
   ::_exit(127);
@@ -180,12 +198,14 @@ ChildEnd child_end(int wait_status, const rusage& ru, double wall_s) {
   return e;
 }
 
-std::optional<Reaped> wait_any() {
+std::optional<Reaped> poll_any() {
   Reaped r;
-  r.pid = ::wait4(-1, &r.wait_status, 0, &r.usage);
-  if (r.pid >= 0) return r;
-  if (errno == EINTR) return std::nullopt;
-  throw ComputeError(fmt::format("waiting for child processes failed: {}", std::strerror(errno)));
+  for (;;) {
+    r.pid = ::wait4(-1, &r.wait_status, WNOHANG, &r.usage);
+    if (r.pid > 0) return r;
+    if (r.pid == 0) return std::nullopt;
+    if (errno != EINTR) throw ComputeError(fmt::format("waiting for child processes failed: {}", std::strerror(errno)));
+  }
 }
 
 std::vector<pid_t> descendants(pid_t root) {

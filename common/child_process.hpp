@@ -10,8 +10,9 @@
 //    stop a child and everything it started (mpirun's ranks, gmsh) with one
 //    kill(-pgid); the child dies with its parent (PR_SET_PDEATHSIG), so no
 //    orphan keeps working on (or locking) a folder;
-//  - the parent's stop handlers reset and SIGINT, SIGTERM, SIGCHLD unblocked
-//    in the child (common/stop_signals.hpp);
+//  - the stop signals blocked across the fork, then the parent's handlers
+//    reset and SIGINT, SIGTERM, SIGCHLD unblocked in the child
+//    (common/stop_signals.hpp); stdin from /dev/null;
 //  - stdout and stderr captured in a log file (or returned: run_captured),
 //    environment set before exec;
 //  - exit status, CPU time and peak memory from wait4()'s rusage, which
@@ -48,8 +49,8 @@ pid_t spawn(const std::function<int()>& body, const ChildSetup& setup = {});
 /// child (an MPI run, a study's runs). Throws ComputeError when unknown.
 std::filesystem::path self_executable();
 
-/// Forks and executes argv (execvpe: argv[0] is looked up in PATH unless it
-/// holds a '/'). Everything the child needs is built before the fork, so the
+/// Forks and executes argv (execvpe: argv[0] is looked up in this process's
+/// PATH, not one given in setup.env, unless it holds a '/'). Everything the child needs is built before the fork, so the
 /// child allocates nothing: safe from a multithreaded parent. Exit 127 when
 /// it cannot execute (the reason is in the log), 126 when the working folder
 /// cannot be entered.
@@ -94,10 +95,11 @@ struct Reaped {
   rusage usage{};
 };
 
-/// Blocks until any child ends (wait4(-1)). nullopt when a signal interrupted
-/// the wait (EINTR: the caller checks its stop flag). Throws ComputeError on
-/// any other error.
-std::optional<Reaped> wait_any();
+/// A child that has ended, reaped without blocking (wait4(-1, WNOHANG)); nullopt
+/// while none has. A loop sleeps in StopSignals::wait() in between (Mode::
+/// wait_for_signal), which a child's end or a stop signal ends. Throws
+/// ComputeError on an error (ECHILD included: call it only with children running).
+std::optional<Reaped> poll_any();
 
 /// Waits for `pid` (started at `start`). After `limit_s` seconds of wall clock
 /// the child's group and descendants get SIGTERM, SIGKILL `grace_s` later; the

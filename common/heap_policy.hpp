@@ -8,14 +8,18 @@
 // time, for the kernel's page faults and the zeroing of every page. Serving
 // all blocks from the heap and never trimming it lets the next factorization
 // reuse the pages the last one freed: on the free expansion's solve (two
-// assembly threads, one rank, runs alternated) 55–58 s became 44–45 s, the
-// peak resident memory 512–521 MB became 529–544 MB.
+// assembly threads, one rank, runs alternated) 55–58 s became 44–45 s with
+// the same settings made through glibc's environment variables and 46 s with
+// this function (one run); the peak resident memory 512–521 MB became
+// 529–544 MB. What a process frees stays resident until it exits: each stage
+// runs in a child of its own (pipeline/stage_process.cpp), so that is the
+// stage's own peak.
 namespace stentsim::heap {
 
 /// Heap for every block, no trimming (mallopt M_MMAP_MAX = 0, M_TRIM_THRESHOLD
 /// = -1), unless the environment already sets glibc's malloc options
-/// (MALLOC_MMAP_MAX_, MALLOC_TRIM_THRESHOLD_, MALLOC_MMAP_THRESHOLD_ or
-/// GLIBC_TUNABLES): then the user's choice stands. Returns true when applied.
+/// (MALLOC_MMAP_MAX_, MALLOC_TRIM_THRESHOLD_, MALLOC_MMAP_THRESHOLD_ or a
+/// glibc.malloc tunable in GLIBC_TUNABLES): then the user's choice stands. Returns true when applied.
 /// glibc falls back to mmap where the heap cannot grow, and thread arenas to
 /// mmap for blocks larger than their heaps.
 bool keep_large_blocks();

@@ -1,24 +1,29 @@
 #include "common/stop_signals.hpp"
 
+#include <poll.h>
+
 #include <csignal>
+#include <ctime>
+#include <initializer_list>
 #include <stdexcept>
 
 namespace stentsim::process {
 namespace {
 
 volatile std::sig_atomic_t g_received = 0;
+int g_depth = 0;  // live StopSignals (nested ones share the flag)
 extern "C" void on_stop(int sig) { g_received = sig; }
-extern "C" void on_child(int) {}  // only ends sigsuspend
+extern "C" void on_child(int) {}  // only ends the wait
 
 }  // namespace
 
 StopSignals::StopSignals(Mode mode) : mode_(mode) {
-  g_received = 0;
+  if (g_depth++ == 0) g_received = 0;
   if (mode_ == Mode::wait_for_signal) {
     sigset_t block;
     sigemptyset(&block);
     for (int s : {SIGINT, SIGTERM, SIGCHLD}) sigaddset(&block, s);
-    sigprocmask(SIG_BLOCK, &block, &old_mask_);
+    pthread_sigmask(SIG_BLOCK, &block, &old_mask_);
     wait_mask_ = old_mask_;
     for (int s : {SIGINT, SIGTERM, SIGCHLD}) sigdelset(&wait_mask_, s);
   }
@@ -38,17 +43,22 @@ StopSignals::StopSignals(Mode mode) : mode_(mode) {
 StopSignals::~StopSignals() {
   // Unblock first, with the handlers still in place: a stop signal that
   // arrived after the last wait sets the flag instead of ending the process.
-  if (mode_ == Mode::wait_for_signal) sigprocmask(SIG_SETMASK, &old_mask_, nullptr);
+  if (mode_ == Mode::wait_for_signal) pthread_sigmask(SIG_SETMASK, &old_mask_, nullptr);
   sigaction(SIGINT, &old_int_, nullptr);
   sigaction(SIGTERM, &old_term_, nullptr);
   if (mode_ == Mode::wait_for_signal) sigaction(SIGCHLD, &old_chld_, nullptr);
+  --g_depth;
 }
 
 int StopSignals::received() { return g_received; }
 
 void StopSignals::wait() const {
   if (mode_ != Mode::wait_for_signal) throw std::logic_error("StopSignals::wait needs Mode::wait_for_signal");
-  sigsuspend(&wait_mask_);
+  // ppoll unblocks and sleeps atomically, like sigsuspend, but for a second at
+  // most: a signal the kernel gave to another thread of the process (one that
+  // does not block it: a library's worker) would not wake this one.
+  const timespec second{1, 0};
+  ::ppoll(nullptr, 0, &second, &wait_mask_);
 }
 
 }  // namespace stentsim::process

@@ -3,14 +3,17 @@
 // stage runner, the cohort pool, the Slurm follower and the study executor.
 // While a StopSignals lives, a stop signal sets a flag instead of ending the
 // process, so the loop can pass SIGTERM on to its children and keep what
-// they finished. The handlers are installed without SA_RESTART: a blocking
-// wait4() returns EINTR and the loop sees the flag at once.
+// they finished. The handlers are installed without SA_RESTART, so a
+// blocking call returns EINTR — but a signal that arrives between a check of
+// the flag and the blocking call is seen only when the call returns.
 //
-// With Mode::wait_for_signal the loop sleeps in wait() instead of a blocking
-// wait: SIGINT, SIGTERM and SIGCHLD stay blocked except inside wait()
-// (sigsuspend), so a signal can fall neither between a check of the flag and
-// the sleep nor between a fork and the registration of the child. Children
-// started by process::spawn unblock them again.
+// Loops that wait for their children therefore use Mode::wait_for_signal: the
+// loop reaps with WNOHANG and sleeps in wait(); SIGINT, SIGTERM and SIGCHLD
+// stay blocked except inside wait() (ppoll with the signals unblocked), so a
+// signal can fall neither between a check of the flag and the sleep nor
+// between a fork and the registration of the child. wait() returns after a
+// second at the latest (a signal delivered to another thread of the process
+// does not wake it). Children started by process::spawn unblock them again.
 #include <signal.h>
 
 namespace stentsim::process {
@@ -21,8 +24,8 @@ class StopSignals {
     interrupt_waits,  ///< a stop signal interrupts blocking calls (EINTR)
     wait_for_signal,  ///< signals blocked; wait() sleeps until one (a child's end included) arrives
   };
-  /// Clears the flag and installs the handlers (a nested one restores the
-  /// outer one's handlers when it goes; the flag is shared).
+  /// Installs the handlers; the outermost one clears the flag (a nested one
+  /// restores the outer one's handlers when it goes; the flag is shared).
   explicit StopSignals(Mode mode = Mode::interrupt_waits);
   /// Restores the handlers and the signal mask the process had before.
   ~StopSignals();
@@ -32,7 +35,7 @@ class StopSignals {
   /// The stop signal received since the last StopSignals was made (0: none).
   /// Still readable after it is gone, until the next one is made.
   static int received();
-  /// Mode::wait_for_signal only: sleeps until a signal arrives.
+  /// Mode::wait_for_signal only: sleeps until a signal arrives, a second at most.
   void wait() const;
 
  private:

@@ -14,6 +14,7 @@
 #include <ostream>
 #include <set>
 
+#include "common/child_process.hpp"
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/stop_signals.hpp"
@@ -117,7 +118,9 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
                                        stages[i].name, o, stages[u].name));
   }
 
-  process::StopSignals signals;  // a stop ends the stages with SIGTERM, keeps what finished
+  // A stop ends the stages with SIGTERM and keeps what finished; signals stay
+  // blocked outside the waits, so none falls between the flag's check and the wait.
+  process::StopSignals signals(process::StopSignals::Mode::wait_for_signal);
   std::set<std::size_t> done, blocked;
   std::map<pid_t, Running> running;
   const int jobs = std::max(1, options.jobs);
@@ -267,15 +270,14 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
     if (running.empty()) break;
     if (process::StopSignals::received())
       for (const auto& [p, r] : running) ::kill(-p, SIGTERM);  // the stage's process group
-    int wstatus = 0;
-    rusage ru{};
-    pid_t pid = ::wait4(-1, &wstatus, 0, &ru);
-    if (pid < 0) {
-      if (errno == EINTR) {
-        continue;  // the loop forwards the stop signal
-      }
-      throw ComputeError(fmt::format("waiting for stages failed: {}", std::strerror(errno)));
+    const auto reaped = process::poll_any();
+    if (!reaped) {
+      signals.wait();  // a stage's end or a stop signal (then the loop forwards it)
+      continue;
     }
+    const pid_t pid = reaped->pid;
+    const int wstatus = reaped->wait_status;
+    const rusage ru = reaped->usage;
     if (!running.count(pid)) continue;
     const std::string finished_name = stages[running.at(pid).stage].name;
     try {

@@ -1,5 +1,6 @@
 // common/child_process: the one implementation of child processes that the
-// stage runner, the error study and the stability suite use. Small shell
+// stage runner, the cohort pool, the Slurm follower, the error study and the
+// stability suite use. Small shell
 // commands: working folder, environment, log capture (truncate or append),
 // exit status, signal, CPU time and peak memory from wait4, and a function
 // body run in a fork.
@@ -129,4 +130,17 @@ TEST(PipelineChildProcess, RunCapturedReturnsBothStreamsAndTheStatus) {
   EXPECT_EQ(missing.end.exit_code, 127);
   EXPECT_NE(missing.output.find("cannot execute /nonexistent/squeue"), std::string::npos) << missing.output;
   EXPECT_THROW(run_captured({}), stentsim::ComputeError);
+}
+
+TEST(PipelineChildProcess, AChildReadsNoTerminal) {
+  // stdin is /dev/null: a read ends at once (a background group reading the
+  // terminal would be stopped by SIGTTIN and its parent wait for ever).
+  const fs::path d = fresh_dir("stdin");
+  ChildSetup s;
+  s.log = d / "log";
+  const ChildEnd e = run({"/bin/sh", "-c", "if read line; then echo got; else echo eof; fi; ls -l /proc/self/fd/0"}, s, 10);
+  EXPECT_TRUE(e.ok()) << e.describe();
+  EXPECT_NE(read(s.log).find("eof"), std::string::npos) << read(s.log);
+  EXPECT_NE(read(s.log).find("/dev/null"), std::string::npos) << read(s.log);
+  fs::remove_all(d);
 }

@@ -1,7 +1,8 @@
 // common/stop_signals: the one SIGINT/SIGTERM handler of the loops that run
 // children. A stop signal sets the flag and leaves the process alive; the old
-// handlers and signal mask come back when it goes; in wait_for_signal mode a
-// child's end wakes wait() and a spawned child still receives SIGTERM.
+// handlers and signal mask come back when it goes; a nested one keeps the
+// outer one's stop; in wait_for_signal mode a child's end wakes wait() and a
+// spawned child still receives SIGTERM.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -22,16 +23,17 @@ bool blocked(int sig) {
   return sigismember(&now, sig) == 1;
 }
 
-bool default_handler(int sig) {
+void (*handler_of(int sig))(int) {
   struct sigaction sa {};
   sigaction(sig, nullptr, &sa);
-  return sa.sa_handler == SIG_DFL;
+  return sa.sa_handler;
 }
 
 }  // namespace
 
 TEST(CommonStopSignals, AStopSignalSetsTheFlagAndTheHandlersComeBack) {
-  ASSERT_TRUE(default_handler(SIGINT));
+  // What the test started with (a background job of a shell may start with SIGINT ignored).
+  const auto int_before = handler_of(SIGINT), term_before = handler_of(SIGTERM);
   {
     StopSignals s;
     EXPECT_EQ(StopSignals::received(), 0);
@@ -41,15 +43,21 @@ TEST(CommonStopSignals, AStopSignalSetsTheFlagAndTheHandlersComeBack) {
     EXPECT_EQ(StopSignals::received(), SIGINT);
   }
   EXPECT_EQ(StopSignals::received(), SIGINT);  // still readable after the loop
-  EXPECT_TRUE(default_handler(SIGINT));
-  EXPECT_TRUE(default_handler(SIGTERM));
+  EXPECT_EQ(handler_of(SIGINT), int_before);
+  EXPECT_EQ(handler_of(SIGTERM), term_before);
   StopSignals again;
   EXPECT_EQ(StopSignals::received(), 0);  // a new one starts clear
+  ::raise(SIGTERM);
+  {
+    StopSignals nested;  // shares the flag: does not clear the outer one's stop
+    EXPECT_EQ(StopSignals::received(), SIGTERM);
+  }
   EXPECT_THROW(again.wait(), std::logic_error);
 }
 
 TEST(CommonStopSignals, WaitModeBlocksUntilWaitAndAChildStillGetsSigterm) {
-  ASSERT_FALSE(blocked(SIGTERM));
+  const bool int_blocked = blocked(SIGINT), chld_blocked = blocked(SIGCHLD);
+  const auto chld_before = handler_of(SIGCHLD);
   {
     StopSignals s(StopSignals::Mode::wait_for_signal);
     EXPECT_TRUE(blocked(SIGINT));
@@ -70,7 +78,7 @@ TEST(CommonStopSignals, WaitModeBlocksUntilWaitAndAChildStillGetsSigterm) {
     s.wait();
     EXPECT_EQ(StopSignals::received(), SIGINT);
   }
-  EXPECT_FALSE(blocked(SIGINT));
-  EXPECT_FALSE(blocked(SIGCHLD));
-  EXPECT_TRUE(default_handler(SIGCHLD));
+  EXPECT_EQ(blocked(SIGINT), int_blocked);
+  EXPECT_EQ(blocked(SIGCHLD), chld_blocked);
+  EXPECT_EQ(handler_of(SIGCHLD), chld_before);
 }

@@ -168,7 +168,8 @@ TEST_F(CohortFaults, StatusShowsRunningAndInterruptStopsThePool) {
   EXPECT_EQ(status_line(st.out, "later").find("running"), std::string::npos) << st.out;
   EXPECT_TRUE(running("slow1", "mesh") && running("slow2", "mesh"));  // looking did not disturb them
 
-  // Ctrl-C to the pool alone (not its process group): it stops its workers.
+  // Ctrl-C to the pool (its workers sit in process groups of their own, so a
+  // terminal's Ctrl-C reaches the pool alone too): it stops its workers.
   ::kill(pid, SIGINT);
   double seconds = 0;
   EXPECT_EQ(finish(&seconds), 130) << output();

@@ -265,19 +265,19 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
         out.flush();
         for (auto& [p, r] : running) ::kill(-p, SIGTERM);  // the worker's group
       }
-      int status = 0;
-      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
-      if (pid == 0) {
-        signals.wait();  // atomically unblocks: a signal sent before this line is pending and wakes it
+      const auto reaped = process::poll_any();
+      if (!reaped) {
+        signals.wait();  // a worker's end or a stop; a signal sent before this line is pending and wakes it
         continue;
       }
-      if (pid < 0) {
-        if (errno == EINTR) continue;
-        throw ComputeError(fmt::format("cohort: waiting for workers failed: {}", std::strerror(errno)));
-      }
+      const pid_t pid = reaped->pid;
+      const int status = reaped->wait_status;
       auto it = running.find(pid);
       if (it == running.end()) continue;
-      CaseOutcome r = case_outcome(c, c.cases[it->second.index], WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
+      int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      // Ended by the pool's own SIGTERM before its runner caught it (still starting up): interrupted.
+      if (stopping && WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) code = 130;
+      CaseOutcome r = case_outcome(c, c.cases[it->second.index], code,
                                    std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count());
       double stage_sum = 0;
       for (const auto& [stage, dt] : stages_finished_since(manifest_of(it->second.index), since)) {

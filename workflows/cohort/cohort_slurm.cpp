@@ -69,7 +69,8 @@ std::string trim(std::string s) {
 }
 
 std::string tail_of(const fs::path& file, std::size_t n) {
-  if (!fs::exists(file)) return "(no Slurm output file " + file.string() + ")";
+  std::error_code ec;  // a shared file system's error must not end the follower (it would cancel the array)
+  if (!fs::exists(file, ec)) return "(no Slurm output file " + file.string() + (ec ? ": " + ec.message() : "") + ")";
   const std::string tail = files::log_tail(file, n);
   return tail.empty() ? "(empty Slurm output " + file.string() + ")" : tail;
 }

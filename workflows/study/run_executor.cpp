@@ -160,8 +160,10 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
   int ranks_in_flight = 0;
   std::size_t next = 0;
 
-  // A stop ends the running runs (SIGTERM to their groups); finished runs keep their results.
-  process::StopSignals signals;
+  // A stop ends the running runs (SIGTERM to their groups); finished runs keep their
+  // results. Signals stay blocked outside the waits: none falls between the flag's check
+  // and the wait.
+  process::StopSignals signals(process::StopSignals::Mode::wait_for_signal);
 
   auto finish = [&](Running& r, bool ok, const std::string& why) {
     const RunSpec& spec = plan.runs[r.run];
@@ -220,8 +222,11 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
         running.emplace(pid, std::move(r));
       }
       if (running.empty()) continue;
-      const auto reaped = process::wait_any();
-      if (!reaped) continue;  // a signal: the loop checks the stop flag
+      const auto reaped = process::poll_any();
+      if (!reaped) {
+        signals.wait();  // a run's end or a stop signal (the loop checks the flag)
+        continue;
+      }
       auto it = running.find(reaped->pid);
       if (it == running.end()) continue;
       Running& r = it->second;
@@ -254,7 +259,8 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
     for (const auto& [pid, r] : running) ::kill(-pid, SIGTERM);
     for (const auto& [pid, r] : running) {
       int st = 0;
-      ::waitpid(pid, &st, 0);
+      while (::waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+      }
     }
     throw;
   }
