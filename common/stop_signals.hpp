@@ -32,8 +32,9 @@ class StopSignals {
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;
 
-  /// The stop signal received since the last StopSignals was made (0: none).
-  /// Still readable after it is gone, until the next one is made.
+  /// The stop signal received since the outermost live StopSignals was made
+  /// (0: none); in wait_for_signal mode it first lets a pending stop signal
+  /// in. Still readable after it is gone, until the next one is made.
   static int received();
   /// Mode::wait_for_signal only: sleeps until a signal arrives, a second at most.
   void wait() const;
@@ -41,6 +42,7 @@ class StopSignals {
  private:
   Mode mode_;
   sigset_t old_mask_{}, wait_mask_{};
+  const sigset_t* outer_wait_mask_ = nullptr;
   struct sigaction old_int_ {}, old_term_ {}, old_chld_ {};
 };
 

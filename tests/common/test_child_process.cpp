@@ -138,7 +138,17 @@ TEST(PipelineChildProcess, AChildReadsNoTerminal) {
   const fs::path d = fresh_dir("stdin");
   ChildSetup s;
   s.log = d / "log";
+  // This process's stdin holds a line for the duration: the child must not see it.
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  ASSERT_EQ(::write(fds[1], "line\n", 5), 5);
+  ::close(fds[1]);
+  const int saved = ::dup(0);
+  ::dup2(fds[0], 0);
+  ::close(fds[0]);
   const ChildEnd e = run({"/bin/sh", "-c", "if read line; then echo got; else echo eof; fi; ls -l /proc/self/fd/0"}, s, 10);
+  ::dup2(saved, 0);
+  ::close(saved);
   EXPECT_TRUE(e.ok()) << e.describe();
   EXPECT_NE(read(s.log).find("eof"), std::string::npos) << read(s.log);
   EXPECT_NE(read(s.log).find("/dev/null"), std::string::npos) << read(s.log);

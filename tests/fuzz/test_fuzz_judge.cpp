@@ -41,4 +41,6 @@ TEST(FuzzJudge, AReadAboveTheMemoryBoundFails) {
   judge_one_read(std::size_t{1} << 20);  // the peak is a read's own: the large one before does not count
   if (inherited) ::setenv("STENTSIM_FUZZ_MEGABYTES", kept.c_str(), 1);
   else ::unsetenv("STENTSIM_FUZZ_MEGABYTES");
+  std::error_code ec;  // the failing read's copy, kept by the judge
+  fs::remove(fs::temp_directory_path() / ("stentsim_fuzz_failing_stentsim_fuzz_judge_" + std::to_string(::getpid())), ec);
 }

@@ -133,8 +133,9 @@ CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_co
   if (r.exit_code == 0)
     // With --until/--only the stage meant to fail may not have run: then "done".
     r.status = k.expect_failure && stage_succeeded(dir / "work" / "manifest.yaml", *k.expect_failure) ? "succeeded unexpectedly" : "done";
+  else if (r.exit_code == 130) r.status = "interrupted";  // before the manifest, which may be an earlier run's
   else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
-  else r.status = r.exit_code == 130 ? "interrupted" : "failed";
+  else r.status = "failed";
   if (r.exit_code) r.message = failure_message(dir / "run.log");
   if (r.exit_code > 128 && r.exit_code != 130)  // the worker itself was killed: its log cannot say so
     r.message = fmt::format("stentsim run killed by signal {} ({}){}", r.exit_code - 128, strsignal(r.exit_code - 128),
@@ -275,7 +276,8 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
       auto it = running.find(pid);
       if (it == running.end()) continue;
       int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      // Ended by the pool's own SIGTERM before its runner caught it (still starting up): interrupted.
+      // Ended by the pool's own SIGTERM before its runner caught it (still starting up): interrupted
+      // (what the progress line says; a stopped pool writes no summary).
       if (stopping && WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) code = 130;
       CaseOutcome r = case_outcome(c, c.cases[it->second.index], code,
                                    std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count());
