@@ -32,7 +32,7 @@ inline int iterations() {
   return n ? std::max(1, std::atoi(n)) : 300;
 }
 
-/// The time a clear error must come within (issue 22: 30 s for any input under 10 MB);
+/// The time a clear error must come within (the hardening target: 30 s for any input under 10 MB);
 /// STENTSIM_FUZZ_SECONDS raises it for instrumented builds, which judge memory errors,
 /// not speed (scripts/run-sanitizers.sh: ASan reads a mutant's huge blocks many times slower).
 inline double seconds_allowed() {
@@ -40,7 +40,7 @@ inline double seconds_allowed() {
   return s ? std::max(1.0, std::atof(s)) : 30.0;
 }
 
-/// The memory a read may add (issue 22: 2 GB for any input under 10 MB);
+/// The memory a read may add (the hardening target: 2 GB for any input under 10 MB);
 /// STENTSIM_FUZZ_MEGABYTES raises it for instrumented builds.
 inline double megabytes_allowed() {
   const char* s = std::getenv("STENTSIM_FUZZ_MEGABYTES");
