@@ -238,6 +238,26 @@ void signal_family(pid_t pid, int sig) {
   for (pid_t d : family) ::kill(d, sig);
 }
 
+void stop_and_reap(const std::vector<pid_t>& pids, double grace_s) {
+  std::vector<pid_t> live = pids;
+  for (pid_t p : live) ::kill(-p, SIGTERM);
+  const auto start = std::chrono::steady_clock::now();
+  bool killed = false;
+  while (!live.empty()) {
+    std::erase_if(live, [](pid_t p) {
+      int status = 0;
+      const pid_t w = ::waitpid(p, &status, WNOHANG);
+      return w == p || (w < 0 && errno == ECHILD);  // reaped, or not ours to wait for
+    });
+    if (live.empty()) break;
+    if (!killed && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > grace_s) {
+      killed = true;
+      for (pid_t p : live) ::kill(-p, SIGKILL);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start, double limit_s, double grace_s) {
   int status = 0;
   rusage ru{};

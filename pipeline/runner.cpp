@@ -285,12 +285,9 @@ RunReport Runner::run(const RunOptions& options, std::ostream& out) {
     } catch (const std::exception& e) {
       // Recording failed (disk full, rename refused): stop the other stages
       // before reporting, so nothing writes the case after the lock is gone.
-      for (const auto& [p, r] : running) ::kill(-p, SIGTERM);
-      while (!running.empty()) {
-        pid_t q = ::waitpid(-1, nullptr, 0);
-        if (q > 0) running.erase(q);
-        else if (errno != EINTR) break;
-      }
+      std::vector<pid_t> pids;
+      for (const auto& [p, r] : running) pids.push_back(p);
+      process::stop_and_reap(pids);
       throw ComputeError(fmt::format("stage {}: {}", finished_name, e.what()));
     }
   }

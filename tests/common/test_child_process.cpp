@@ -6,12 +6,16 @@
 // body run in a fork.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "common/error.hpp"
 #include "common/child_process.hpp"
@@ -83,6 +87,24 @@ TEST(PipelineChildProcess, ExecFailureSignalAndTiming) {
   EXPECT_LT(slow.wall_s, 5);
   EXPECT_NE(slow.describe().find("timed out"), std::string::npos);
   fs::remove_all(d);
+}
+
+// The error path of a runner: a child that ignores SIGTERM (a stage stuck in a
+// library) is killed after the grace period; both are reaped.
+TEST(PipelineChildProcess, StopAndReapKillsAChildThatIgnoresTerm) {
+  const pid_t stubborn = spawn_exec({"sh", "-c", "trap '' TERM; sleep 30; exit 0"});
+  const pid_t polite = spawn_exec({"sleep", "30"});
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the trap is set
+  const auto start = std::chrono::steady_clock::now();
+  stentsim::process::stop_and_reap({stubborn, polite}, 0.5);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(took, 0.5);  // the stubborn one outlived SIGTERM
+  EXPECT_LT(took, 10.0);
+  for (const pid_t p : {stubborn, polite}) {
+    errno = 0;
+    EXPECT_EQ(::waitpid(p, nullptr, WNOHANG), -1);
+    EXPECT_EQ(errno, ECHILD);  // already reaped
+  }
 }
 
 TEST(PipelineChildProcess, BodyRunsInItsOwnProcessGroup) {

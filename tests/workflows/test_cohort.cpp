@@ -405,6 +405,39 @@ TEST(CohortEta, MedianStageTimesOverRemainingWork) {
   EXPECT_DOUBLE_EQ(*cohort_eta(samples, {{}, {}, {}}, 0), 21.0);  // at least one at a time
 }
 
+// A case whose manifest cannot be read fails alone, with the reason; the pool
+// (and the Slurm follower) that asks goes on with the other cases.
+TEST(CohortOutcome, AnUnreadableManifestFailsItsCaseAndNothingElse) {
+  using namespace stentsim::workflows;
+  const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-outcome-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "a" / "work");
+  stentsim::files::write_atomic(dir / "a" / "work" / "manifest.yaml", "stages: {centerline: [unclosed\n");
+  stentsim::files::write_atomic(dir / "a" / "run.log", "error: mesh: the wall is inside the lumen\n");
+  CohortConfig c;
+  c.work_dir = dir;
+  CohortCase k;
+  k.id = "a";
+  CaseOutcome r;
+  ASSERT_NO_THROW(r = case_outcome(c, k, 1, 2.0));
+  EXPECT_EQ(r.status, "failed");
+  EXPECT_EQ(r.error_kind, "unknown");
+  EXPECT_NE(r.manifest_error.find((dir / "a" / "work" / "manifest.yaml").string() + ": unreadable"), std::string::npos)
+      << r.manifest_error;
+  EXPECT_NE(r.message.find("the wall is inside the lumen"), std::string::npos) << r.message;
+  // A run that succeeded is only asked about its manifest when a stage was meant to fail.
+  EXPECT_EQ(case_outcome(c, k, 0, 2.0).status, "done");
+  k.expect_failure = "placement";
+  EXPECT_EQ(case_outcome(c, k, 0, 2.0).status, "failed");
+  EXPECT_EQ(case_outcome(c, k, 130, 2.0).status, "interrupted");
+  // Readable again: the usual outcome.
+  fs::remove(dir / "a" / "work" / "manifest.yaml");
+  EXPECT_EQ(case_outcome(c, k, 1, 2.0).status, "failed");
+  EXPECT_TRUE(case_outcome(c, k, 1, 2.0).manifest_error.empty());
+  EXPECT_EQ(case_outcome(c, k, 0, 2.0).status, "done");
+  fs::remove_all(dir);
+}
+
 TEST(CohortExample, SevereCaseFailsAtPlacementAsExpected) {
   const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-example-" + std::to_string(::getpid()));
   fs::remove_all(dir);

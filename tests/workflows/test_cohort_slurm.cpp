@@ -296,6 +296,58 @@ TEST_F(CohortSlurm, InterruptCancelsSubmittedTasks) {
   EXPECT_EQ(active_queue(), "");  // cancelled tasks may be listed as CANCELLED, never pending or running
 }
 
+// A folder holding an `squeue` that fails (as when the controller restarts)
+// on its first `fail` calls from the follower (the `%i %T` query), then hands
+// over to the real one; `fail` < 0: always.
+fs::path failing_squeue(const fs::path& dir, int fail) {
+  const fs::path bin = dir / "shim";
+  fs::create_directories(bin);
+  const std::string real = capture("command -v squeue");
+  write_atomic(bin / "squeue", "#!/bin/bash\n"
+                               "n=$(cat " + (bin / "count").string() + " 2>/dev/null || echo 0)\n"
+                               "case \" $* \" in *\" %i %T \"*)\n"
+                               "  if [ " + std::to_string(fail) + " -lt 0 ] || [ \"$n\" -lt " + std::to_string(fail) + " ]; then\n"
+                               "    echo $((n + 1)) > " + (bin / "count").string() + "\n"
+                               "    echo 'squeue: error: Unable to contact slurm controller (connect failure)' >&2; exit 1\n"
+                               "  fi;;\n"
+                               "esac\n"
+                               "exec " + real.substr(0, real.find('\n')) + " \"$@\"\n");
+  fs::permissions(bin / "squeue", fs::perms::owner_all);
+  return bin;
+}
+
+// squeue failing for a few polls does not end the follower (it used to cancel
+// the whole array): it waits, says so, and the cases finish as usual.
+TEST_F(CohortSlurm, AQueueThatStopsAnsweringForAWhileIsWaitedOut) {
+  const auto f = cohort("blip", "backend: slurm\nslurm: {poll_interval_s: 0.2}\n");
+  const fs::path bin = failing_squeue(dir, 3);
+  const std::string out = capture("PATH=" + bin.string() + ":$PATH " + std::string(STENTSIM_TEST_BINARY) + " cohort run " + f +
+                                  " --until centerline 2>&1; echo exit=$?");
+  EXPECT_NE(out.find("squeue failed (exit 1): squeue: error: Unable to contact slurm controller"), std::string::npos) << out;
+  EXPECT_NE(out.find("trying again for up to 300 s"), std::string::npos) << out;
+  EXPECT_NE(out.find("slurm: squeue answers again"), std::string::npos) << out;
+  EXPECT_EQ(out.find("cancelled"), std::string::npos) << out;
+  EXPECT_NE(out.find("3 cases: 3 as expected, 0 unexpected"), std::string::npos) << out;
+  EXPECT_NE(out.find("exit=0"), std::string::npos) << out;
+  EXPECT_EQ(read_text(bin / "count"), "3\n");
+}
+
+// A queue that stays silent past slurm.queue_patience_s ends the follower with
+// an error that says how to follow up, and the tasks are left to run.
+TEST_F(CohortSlurm, AQueueSilentPastItsPatienceLeavesTheTasksRunning) {
+  const auto f = cohort("silent", "backend: slurm\nslurm: {extra_sbatch_options: \"--hold\", poll_interval_s: 0.2, queue_patience_s: 1}\n");
+  const fs::path bin = failing_squeue(dir, -1);
+  const std::string out = capture("PATH=" + bin.string() + ":$PATH " + std::string(STENTSIM_TEST_BINARY) + " cohort run " + f +
+                                  " --until centerline 2>&1; echo exit=$?");
+  EXPECT_NE(out.find("submitted job array"), std::string::npos) << out;
+  EXPECT_NE(out.find("the submitted tasks were left to run: follow them with `stentsim cohort status " + f + "`"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(out.find("cancelled"), std::string::npos) << out;
+  EXPECT_NE(out.find("exit=1"), std::string::npos) << out;
+  EXPECT_EQ(lines(active_queue()), 3) << active_queue();  // still held in the queue
+}
+
 TEST(CohortSlurmErrors, MissingSbatchIsAClearError) {
   const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-nosbatch-" + std::to_string(::getpid()));
   fs::remove_all(dir);

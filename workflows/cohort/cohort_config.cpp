@@ -128,6 +128,7 @@ CohortConfig load_cohort(const fs::path& file) {
     c.slurm.memory = sm->string("memory", std::string());
     c.slurm.cpus_per_case = sm->integer("cpus_per_case", 1, Range::between(1, 1024));
     c.slurm.poll_interval_s = sm->number("poll_interval_s", 1.0, Range::between(0.05, 600));
+    c.slurm.queue_patience_s = sm->number("queue_patience_s", 300.0, Range::between(0, 86400));
     // One string of options separated by spaces (no shell quoting is applied).
     std::istringstream extra(sm->string("extra_sbatch_options", std::string()));
     for (std::string opt; extra >> opt;) {

@@ -29,6 +29,7 @@ struct SlurmOptions {
   int cpus_per_case = 1;                  // --cpus-per-task
   std::vector<std::string> extra_options; // extra sbatch options ("extra_sbatch_options: --qos=short --mem-per-cpu=1G")
   double poll_interval_s = 1.0;           // squeue polling period
+  double queue_patience_s = 300.0;        // how long squeue may fail before the follower gives up (the tasks keep running)
 };
 
 struct CohortConfig {

@@ -66,7 +66,7 @@ std::string error_kind_of(int exit_code, const std::optional<pipeline::StageReco
 }
 
 bool stage_succeeded(const fs::path& manifest_file, const std::string& stage) {
-  if (!fs::exists(manifest_file)) return false;
+  if (!fs::exists(manifest_file)) return false;  // throws on a file-system error (case_outcome catches it)
   const auto m = pipeline::Manifest::load(manifest_file);
   const auto* rec = m.find(stage);
   return rec && rec->status == "ok";
@@ -128,11 +128,28 @@ CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_co
   r.id = k.id;
   r.wall_s = wall_s;
   r.exit_code = exit_code;
-  const auto failed = r.exit_code ? failed_record(dir / "work" / "manifest.yaml", r.failed_stage) : std::nullopt;
+  const fs::path manifest = dir / "work" / "manifest.yaml";
+  // An unreadable manifest (damaged, a permission, a shared file system that shows a
+  // rewrite half done) is this case's failure, never the pool's: the other cases go on.
+  std::optional<pipeline::StageRecord> failed;
+  bool expected_stage_ran = false;
+  try {
+    if (r.exit_code) failed = failed_record(manifest, r.failed_stage);
+    else if (k.expect_failure) expected_stage_ran = stage_succeeded(manifest, *k.expect_failure);
+  } catch (const std::exception& e) {
+    r.manifest_error = fmt::format("{}: unreadable ({})", manifest.string(), e.what());
+  }
   r.error_kind = error_kind_of(r.exit_code, failed);
+  if (!r.manifest_error.empty() && r.exit_code != 130) {
+    r.status = "failed";
+    r.error_kind = "unknown";
+    r.message = r.manifest_error;
+    if (r.exit_code) r.message += "; log: " + failure_message(dir / "run.log");
+    return r;
+  }
   if (r.exit_code == 0)
     // With --until/--only the stage meant to fail may not have run: then "done".
-    r.status = k.expect_failure && stage_succeeded(dir / "work" / "manifest.yaml", *k.expect_failure) ? "succeeded unexpectedly" : "done";
+    r.status = expected_stage_ran ? "succeeded unexpectedly" : "done";
   else if (r.exit_code == 130) r.status = "interrupted";  // before the manifest, which may be an earlier run's
   else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
   else r.status = "failed";
@@ -213,12 +230,13 @@ std::optional<double> cohort_eta(const std::map<std::string, std::vector<double>
 
 std::map<std::string, double> stages_finished_since(const fs::path& manifest_file, const std::string& since) {
   std::map<std::string, double> out;
-  if (!fs::exists(manifest_file)) return out;
+  std::error_code ec;
+  if (!fs::exists(manifest_file, ec)) return out;
   pipeline::Manifest m;
   try {
     m = pipeline::Manifest::load(manifest_file);
-  } catch (const InputError&) {
-    return out;  // being rewritten elsewhere (a Slurm task on another node): next time
+  } catch (const std::exception&) {
+    return out;  // for the ETA only; being rewritten elsewhere (a Slurm task on another node): next time
   }
   for (const auto& [name, rec] : m.stages())
     if (rec.status == "ok" && rec.finished >= since) out[name] = rec.duration_s;  // ISO 8601 UTC sorts as text
@@ -252,60 +270,69 @@ CohortReport run_cohort(const CohortConfig& c, const CohortRunOptions& o, std::o
     // between the flag's check and the sleep nor between a fork and the
     // registration of its worker.
     process::StopSignals signals(process::StopSignals::Mode::wait_for_signal);
-    while (true) {
-      while (!process::StopSignals::received() && next < todo.size() && static_cast<int>(running.size()) < slots) {
-        const std::size_t i = todo[next++];
-        const fs::path dir = c.work_dir / c.cases[i].id;
-        const pid_t pid = start_case(o.binary, case_files[i], o.run_args, dir / "run.log");
-        running[pid] = {i, std::chrono::steady_clock::now()};  // still blocked: no signal in between
-      }
-      if (running.empty()) break;
-      if (process::StopSignals::received() && !stopping) {
-        stopping = true;
-        out << fmt::format("stopping: {} running case(s) get SIGTERM (their runners keep finished stages)\n", running.size());
+    try {
+      while (true) {
+        while (!process::StopSignals::received() && next < todo.size() && static_cast<int>(running.size()) < slots) {
+          const std::size_t i = todo[next++];
+          const fs::path dir = c.work_dir / c.cases[i].id;
+          const pid_t pid = start_case(o.binary, case_files[i], o.run_args, dir / "run.log");
+          running[pid] = {i, std::chrono::steady_clock::now()};  // still blocked: no signal in between
+        }
+        if (running.empty()) break;
+        if (process::StopSignals::received() && !stopping) {
+          stopping = true;
+          out << fmt::format("stopping: {} running case(s) get SIGTERM (their runners keep finished stages)\n", running.size());
+          out.flush();
+          for (auto& [p, r] : running) ::kill(-p, SIGTERM);  // the worker's group
+        }
+        const auto reaped = process::poll_any();
+        if (!reaped) {
+          signals.wait();  // a worker's end or a stop; a signal sent before this line is pending and wakes it
+          continue;
+        }
+        const pid_t pid = reaped->pid;
+        const int status = reaped->wait_status;
+        auto it = running.find(pid);
+        if (it == running.end()) continue;
+        int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        // Ended by the pool's own SIGTERM before its runner caught it (still starting up): interrupted
+        // (what the progress line says; a stopped pool writes no summary).
+        if (stopping && WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) code = 130;
+        CaseOutcome r = case_outcome(c, c.cases[it->second.index], code,
+                                     std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count());
+        double stage_sum = 0;
+        for (const auto& [stage, dt] : stages_finished_since(manifest_of(it->second.index), since)) {
+          stage_samples[stage].push_back(dt);
+          stage_sum += dt;
+        }
+        // What a case costs besides its stages (start-up, planning, hashing):
+        // counted like a stage that a running case has already paid.
+        stage_samples[kStartup].push_back(std::max(0.0, r.wall_s - stage_sum));
+        running.erase(it);
+        done.push_back(r);
+        // ETA: what the unfinished cases still need, at the median stage times so far.
+        std::vector<std::set<std::string>> finished;
+        for (const auto& [p, rr] : running) {
+          std::set<std::string> s = {kStartup};
+          for (const auto& [stage, dt] : stages_finished_since(manifest_of(rr.index), since)) s.insert(stage);
+          finished.push_back(s);
+        }
+        for (std::size_t k = next; k < todo.size(); ++k) finished.emplace_back();
+        const auto eta = cohort_eta(stage_samples, finished, slots);
+        const int failed = static_cast<int>(std::count_if(done.begin(), done.end(), [](const CaseOutcome& d) { return !d.as_expected(); }));
+        out << fmt::format("[{}/{}] {:<20} {}{}  ({} unexpected, {:.0f} s elapsed, ETA {})\n", done.size(), todo.size(), r.id,
+                           r.status, r.failed_stage.empty() ? "" : " at " + r.failed_stage, failed,
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                           eta ? fmt::format("{:.0f} s", *eta) : std::string("-"));
         out.flush();
-        for (auto& [p, r] : running) ::kill(-p, SIGTERM);  // the worker's group
       }
-      const auto reaped = process::poll_any();
-      if (!reaped) {
-        signals.wait();  // a worker's end or a stop; a signal sent before this line is pending and wakes it
-        continue;
-      }
-      const pid_t pid = reaped->pid;
-      const int status = reaped->wait_status;
-      auto it = running.find(pid);
-      if (it == running.end()) continue;
-      int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      // Ended by the pool's own SIGTERM before its runner caught it (still starting up): interrupted
-      // (what the progress line says; a stopped pool writes no summary).
-      if (stopping && WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) code = 130;
-      CaseOutcome r = case_outcome(c, c.cases[it->second.index], code,
-                                   std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count());
-      double stage_sum = 0;
-      for (const auto& [stage, dt] : stages_finished_since(manifest_of(it->second.index), since)) {
-        stage_samples[stage].push_back(dt);
-        stage_sum += dt;
-      }
-      // What a case costs besides its stages (start-up, planning, hashing):
-      // counted like a stage that a running case has already paid.
-      stage_samples[kStartup].push_back(std::max(0.0, r.wall_s - stage_sum));
-      running.erase(it);
-      done.push_back(r);
-      // ETA: what the unfinished cases still need, at the median stage times so far.
-      std::vector<std::set<std::string>> finished;
-      for (const auto& [p, rr] : running) {
-        std::set<std::string> s = {kStartup};
-        for (const auto& [stage, dt] : stages_finished_since(manifest_of(rr.index), since)) s.insert(stage);
-        finished.push_back(s);
-      }
-      for (std::size_t k = next; k < todo.size(); ++k) finished.emplace_back();
-      const auto eta = cohort_eta(stage_samples, finished, slots);
-      const int failed = static_cast<int>(std::count_if(done.begin(), done.end(), [](const CaseOutcome& d) { return !d.as_expected(); }));
-      out << fmt::format("[{}/{}] {:<20} {}{}  ({} unexpected, {:.0f} s elapsed, ETA {})\n", done.size(), todo.size(), r.id,
-                         r.status, r.failed_stage.empty() ? "" : " at " + r.failed_stage, failed,
-                         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                         eta ? fmt::format("{:.0f} s", *eta) : std::string("-"));
-      out.flush();
+    } catch (...) {
+      // The pool cannot go on (a worker that could not start, an output error): its
+      // workers stop with it rather than writing cases nobody follows.
+      std::vector<pid_t> pids;
+      for (const auto& [p, r] : running) pids.push_back(p);
+      process::stop_and_reap(pids);
+      throw;
     }
   }
   CohortReport rep;

@@ -33,6 +33,7 @@ struct CaseOutcome {
   /// `stentsim run` refused (exit 2), crash for a killed worker, interrupted, lost (Slurm).
   std::string error_kind;
   std::string message;       // last lines of the case's log on failure
+  std::string manifest_error;  // why the case's manifest could not be read (empty: it could); status failed then
   int exit_code = 0;         // the case's `stentsim run`: its exit status, 128 + signal when killed, -1 unknown (lost)
   double wall_s = 0;
   bool as_expected() const { return status == "done" || status == "failed as expected"; }

@@ -108,6 +108,11 @@ void cancel(const std::vector<std::string>& tasks, std::ostream& out) {
   out.flush();
 }
 
+// The follower gave up on a queue that stopped answering.
+struct QueueUnreachable : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 void sleep_interruptibly(double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!process::StopSignals::received() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -456,6 +461,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
     std::size_t index;
     std::chrono::steady_clock::time_point since;
     std::optional<std::chrono::steady_clock::time_point> gone;  // first seen outside the queue without exit code
+    std::optional<std::chrono::steady_clock::time_point> unreadable;  // first seen with its manifest unreadable
     bool finished = false;
   };
   std::vector<Follow> follow;
@@ -539,11 +545,33 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
   const double grace = std::max(2.0, 3 * c.slurm.poll_interval_s);
   std::string last_line;
   try {
+    // squeue failing for a while (the controller restarting, a network blip) is waited
+    // out; only a long outage ends the follower, and then the tasks keep running.
+    const double queue_patience = c.slurm.queue_patience_s;
+    std::optional<std::chrono::steady_clock::time_point> queue_failing;
     while (!process::StopSignals::received() && std::any_of(follow.begin(), follow.end(), [](const Follow& f) { return !f.finished; })) {
       std::set<std::string> live;
       for (const auto& f : follow)
         if (!f.finished) live.insert(tasks.at(c.cases[f.index].id).array);
-      const auto st = task_states(live);
+      std::map<std::string, std::string> st;
+      try {
+        st = task_states(live);
+        if (queue_failing) out << "slurm: squeue answers again\n";
+        queue_failing.reset();
+      } catch (const ComputeError& e) {
+        const auto now = std::chrono::steady_clock::now();
+        if (!queue_failing) {
+          queue_failing = now;
+          out << fmt::format("{}; trying again for up to {:.0f} s\n", e.what(), queue_patience);
+          out.flush();
+        }
+        const double failing_s = std::chrono::duration<double>(now - *queue_failing).count();
+        if (failing_s > queue_patience)
+          throw QueueUnreachable(fmt::format("{} (for {:.0f} s); the submitted tasks were left to run: follow them with "
+                                             "`stentsim cohort status {}`", e.what(), failing_s, c.file.string()));
+        sleep_interruptibly(c.slurm.poll_interval_s);
+        continue;
+      }
       int pending = 0, running = 0;
       for (auto& f : follow) {
         if (f.finished) continue;
@@ -556,6 +584,12 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
         }
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - f.since).count();
         std::optional<CaseOutcome> r = finished_outcome(c, k, t, wall);
+        if (r && !r->manifest_error.empty()) {
+          // A manifest another node is still writing reads as damaged for a moment: the grace
+          // period again before the case counts as failed.
+          if (!f.unreadable) f.unreadable = std::chrono::steady_clock::now();
+          if (std::chrono::duration<double>(std::chrono::steady_clock::now() - *f.unreadable).count() < grace) continue;
+        }
         if (!r) {
           if (!f.gone) f.gone = std::chrono::steady_clock::now();
           if (std::chrono::duration<double>(std::chrono::steady_clock::now() - *f.gone).count() < grace) continue;
@@ -592,6 +626,8 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
       if (std::any_of(follow.begin(), follow.end(), [](const Follow& f) { return !f.finished; }))
         sleep_interruptibly(c.slurm.poll_interval_s);
     }
+  } catch (const QueueUnreachable& e) {
+    throw ComputeError(e.what());  // scancel would not reach the controller either
   } catch (...) {
     cancel(active_tasks(), out);
     throw;

@@ -256,12 +256,9 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
       finish(done, ok, why);
     }
   } catch (...) {
-    for (const auto& [pid, r] : running) ::kill(-pid, SIGTERM);
-    for (const auto& [pid, r] : running) {
-      int st = 0;
-      while (::waitpid(pid, &st, 0) < 0 && errno == EINTR) {
-      }
-    }
+    std::vector<pid_t> pids;
+    for (const auto& [pid, r] : running) pids.push_back(pid);
+    process::stop_and_reap(pids);
     throw;
   }
   return stats;
