@@ -1,8 +1,9 @@
-// Mutation fuzzing of the label-image readers (NIfTI plain and gzip, NRRD,
-// MetaImage header, detached raw data and single file): each mutant of a small
-// cylinder label either gives a surface or an InputError naming the file. The
-// gzip file's decoded bytes are mutated and compressed again, so mutants reach
-// the NIfTI parser instead of all failing zlib's check.
+// Mutation fuzzing of the label-image readers (NIfTI plain and gzip, NRRD raw
+// and gzip, MetaImage header, detached raw data, single file plain and
+// compressed): each mutant of a small cylinder label either gives a surface or
+// an InputError naming the file. Compressed files are re-sealed: their decoded
+// bytes (or their header) are mutated and the data compressed again, so
+// mutants reach the parsers instead of all failing zlib's check.
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <vtkImageData.h>
@@ -57,14 +58,19 @@ std::string nifti(const fs::path& dir) {
   return slurp(dir / "seed.nii");
 }
 
-std::string nrrd() {
-  std::string s = "NRRD0004\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\nsizes: 14 14 30\n"
-                  "space directions: (0.5,0,0) (0,0.5,0) (0,0,0.5)\nkind: domain domain domain\nendian: little\n"
-                  "encoding: raw\nspace origin: (1,2,3)\n\n";
+std::string nrrd_header(const std::string& encoding) {
+  return "NRRD0004\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\nsizes: 14 14 30\n"
+         "space directions: (0.5,0,0) (0,0.5,0) (0,0,0.5)\nkind: domain domain domain\nendian: little\n"
+         "encoding: " + encoding + "\nspace origin: (1,2,3)\n\n";
+}
+
+std::string voxels() {
   auto im = cylinder();
   const auto* p = static_cast<const char*>(im->GetScalarPointer());
-  return s.append(p, static_cast<std::size_t>(kDim[0] * kDim[1] * kDim[2]));
+  return std::string(p, static_cast<std::size_t>(kDim[0] * kDim[1] * kDim[2]));
 }
+
+std::string nrrd() { return nrrd_header("raw") + voxels(); }
 
 // MetaImage: header seed.mhd with ElementDataFile seed.raw, or a single .mha.
 void metaimage(const fs::path& file) {
@@ -88,6 +94,21 @@ std::string gzip(const std::string& data) {
   out.resize(z.total_out);
   deflateEnd(&z);
   return out;
+}
+
+// A zlib stream (MetaImage's CompressedData).
+std::string zlib(const std::string& data) {
+  uLongf size = compressBound(static_cast<uLong>(data.size()));
+  std::string out(size, '\0');
+  compress(reinterpret_cast<Bytef*>(out.data()), &size, reinterpret_cast<const Bytef*>(data.data()), static_cast<uLong>(data.size()));
+  out.resize(size);
+  return out;
+}
+
+// A single-file MetaImage with zlib data, its CompressedDataSize true to `data`.
+std::string mha_zlib(const std::string& header, const std::string& data) {
+  const std::string z = zlib(data);
+  return header + "CompressedDataSize = " + std::to_string(z.size()) + "\nElementDataFile = LOCAL\n" + z;
 }
 
 void read_label_image(const fs::path& f) {
@@ -127,5 +148,30 @@ TEST(LabelImageFuzz, MutantsReadOrFailWithAnInputError) {
   const std::string mha = slurp(dir / "seed.mha");
   fuzz::judge("mha", n, [&](int) { fuzz::write_file(dir / "t.mha", fuzz::mutate(mha, gen)); return dir / "t.mha"; },
               read_label_image);
+  // Re-sealed: half the mutants change the header, half the decoded voxels; the data is
+  // compressed (again) after the mutation.
+  const std::string vox = voxels();
+  std::uniform_int_distribution<int> coin(0, 1);
+  const std::string nrrd_gz_header = nrrd_header("gzip");
+  fuzz::write_file(dir / "t.nrrd", nrrd_gz_header + gzip(vox));
+  ASSERT_NO_THROW(read_label_image(dir / "t.nrrd")) << "the gzip NRRD seed must read";
+  const auto nrrd_gz = fuzz::judge("nrrd gzip", n, [&](int) {
+    const bool header = coin(gen);
+    fuzz::write_file(dir / "t.nrrd", (header ? fuzz::mutate(nrrd_gz_header, gen) : nrrd_gz_header) + gzip(header ? vox : fuzz::mutate(vox, gen)));
+    return dir / "t.nrrd";
+  }, read_label_image);
+  const std::string mha_header =
+      "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\nCompressedData = True\n"
+      "Offset = 1 2 3\nElementSpacing = 0.5 0.5 0.5\nDimSize = 14 14 30\nElementType = MET_UCHAR\n";
+  fuzz::write_file(dir / "t.mha", mha_zlib(mha_header, vox));
+  ASSERT_NO_THROW(read_label_image(dir / "t.mha")) << "the compressed MetaImage seed must read";
+  const auto mha_z = fuzz::judge("mha zlib", n, [&](int) {
+    const bool header = coin(gen);
+    fuzz::write_file(dir / "t.mha", mha_zlib(header ? fuzz::mutate(mha_header, gen) : mha_header, header ? vox : fuzz::mutate(vox, gen)));
+    return dir / "t.mha";
+  }, read_label_image);
+  // Re-sealed mutants reach the voxels: most of them read (a changed label is still a label image).
+  EXPECT_GT(nrrd_gz.read, n / 4);
+  EXPECT_GT(mha_z.read, n / 4);
   fs::remove_all(dir);
 }

@@ -4,10 +4,18 @@
 // InputError naming the file. VTK's parser crashes on some mutants in-process; the
 // readers read each file in a child process first (check_vtk_xml_file). Seeds are
 // written uncompressed (raw appended and ASCII), so mutants reach the parser and the
-// data instead of all failing zlib, plus the compressed file as stentsim writes it.
+// data instead of all failing zlib, plus the compressed file as stentsim writes it,
+// mutated as bytes and re-sealed: the decoded arrays (points, connectivity, offsets,
+// cell types, data arrays) mutated in memory, then written with zlib again.
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
 #include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkPolyData.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLPolyDataReader.h>
@@ -15,8 +23,11 @@
 #include <vtkXMLUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "common/files.hpp"
 #include "common/mesh_data.hpp"
@@ -49,6 +60,23 @@ std::string rewritten(const fs::path& in, const fs::path& out, bool ascii) {
   return files::read_text(out);
 }
 
+// One decoded array of `g` mutated in place (its length kept), chosen by `gen`.
+void mutate_an_array(vtkUnstructuredGrid* g, std::mt19937& gen) {
+  std::vector<vtkDataArray*> arrays = {g->GetPoints()->GetData(), g->GetCells()->GetConnectivityArray(),
+                                       g->GetCells()->GetOffsetsArray(), g->GetCellTypesArray()};
+  for (int i = 0; i < g->GetPointData()->GetNumberOfArrays(); ++i) arrays.push_back(g->GetPointData()->GetArray(i));
+  for (int i = 0; i < g->GetCellData()->GetNumberOfArrays(); ++i) arrays.push_back(g->GetCellData()->GetArray(i));
+  std::erase(arrays, nullptr);
+  vtkDataArray* a = arrays[std::uniform_int_distribution<std::size_t>(0, arrays.size() - 1)(gen)];
+  const std::size_t bytes = static_cast<std::size_t>(a->GetNumberOfValues()) * static_cast<std::size_t>(a->GetDataTypeSize());
+  if (bytes == 0) return;
+  auto* p = static_cast<char*>(a->GetVoidPointer(0));
+  std::string m = fuzz::mutate(std::string(p, bytes), gen);
+  m.resize(bytes, '\0');
+  std::memcpy(p, m.data(), bytes);
+  a->Modified();
+}
+
 void check(const MeshData& m) {
   for (auto id : m.connectivity) ASSERT_TRUE(id >= 0 && static_cast<std::size_t>(id) < m.points.size());
 }
@@ -68,6 +96,25 @@ TEST(VtkXmlFuzz, MutantsReadOrFailWithAnInputError) {
   for (const auto& [format, seed] : vtu)
     fuzz::judge(format, n, [&](int) { fuzz::write_file(dir / "t.vtu", fuzz::mutate(seed, gen)); return dir / "t.vtu"; },
                 [](const fs::path& f) { check(read_vtu(f.string())); });
+  {
+    vtkNew<vtkXMLUnstructuredGridReader> r;
+    r->SetFileName(balloon.c_str());
+    r->Update();
+    const auto t = fuzz::judge("vtu zlib sealed", n, [&](int) {
+      vtkNew<vtkUnstructuredGrid> g;
+      g->DeepCopy(r->GetOutput());
+      mutate_an_array(g, gen);
+      vtkNew<vtkXMLUnstructuredGridWriter> w;
+      w->SetInputData(g);
+      w->SetFileName((dir / "t.vtu").c_str());
+      w->SetCompressorTypeToZLib();
+      w->SetDataModeToAppended();
+      w->Write();
+      return dir / "t.vtu";
+    }, [](const fs::path& f) { check(read_vtu(f.string())); });
+    EXPECT_GT(t.read, n / 4);  // the mutants get past zlib: most read
+    EXPECT_GT(t.refused, 0);   // and some reach the index checks
+  }
   // A poly data file: the stent's surface-free centerline is no .vtp; the balloon's cells as polys are.
   MeshData surface;
   const MeshData b = read_vtu(balloon.string());
