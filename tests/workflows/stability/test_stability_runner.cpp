@@ -57,6 +57,19 @@ TEST(StabilityRunner, SuccessIsConverged) {
   EXPECT_FALSE(o.run.timed_out);
 }
 
+// A case is timed on one thread of every library, ours included, whatever this process has set.
+TEST(StabilityRunner, ACaseRunsOnOneThreadOfEveryLibrary) {
+  ::setenv("STENTSIM_THREADS", "4", 1);
+  const fs::path dir = fresh_dir("env");
+  const ChildRun r = run_child({"/bin/sh", "-c", "env"}, dir, dir / "log.txt", 30);
+  ::unsetenv("STENTSIM_THREADS");
+  ASSERT_EQ(r.exit_code, 0);
+  const std::string env = "\n" + read(dir / "log.txt");
+  for (const char* want : {"\nOMP_NUM_THREADS=1\n", "\nOPENBLAS_NUM_THREADS=1\n", "\nSTENTSIM_THREADS=1\n",
+                           "\nVTK_SMP_BACKEND_IN_USE=Sequential\n"})
+    EXPECT_NE(env.find(want), std::string::npos) << want << " not in\n" << env;
+}
+
 TEST(StabilityRunner, NonzeroExitWithMessageIsCleanFailure) {
   const auto o = run_one(sh_case("clean", "echo step 1; echo 'error: no converged state beyond p = 0.3' >&2; echo bye; exit 1"));
   EXPECT_EQ(o.outcome, "failed cleanly");

@@ -11,7 +11,7 @@ ChildRun run_child(const std::vector<std::string>& argv, const fs::path& cwd, co
   process::ChildSetup setup;
   setup.cwd = cwd;
   setup.log = log;
-  setup.env = {{"OMP_NUM_THREADS", "1"}};
+  setup.env = process::single_thread_environment();
   const auto start = std::chrono::steady_clock::now();
   const pid_t pid = process::spawn_exec(argv, setup);
   return process::wait_with_limit(pid, start, limit_s);

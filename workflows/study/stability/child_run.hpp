@@ -19,9 +19,10 @@ using ChildRun = process::ChildEnd;
 /// argv in `cwd`, output to `log` (truncated). After `limit_s` seconds the
 /// child's process group and descendants get SIGTERM, and SIGKILL 2 s later;
 /// the run then counts as timed out whatever its status. Cases run one at a
-/// time and are timed: OMP_NUM_THREADS=1 so that a case's time does not
-/// depend on how many cores the machine lends it. Throws ComputeError when it
-/// cannot start.
+/// time and are timed: every library and the assembly on one thread
+/// (process::single_thread_environment) so that a case's time does not depend
+/// on how many cores the machine lends it. Throws ComputeError when it cannot
+/// start.
 ChildRun run_child(const std::vector<std::string>& argv, const std::filesystem::path& cwd,
                    const std::filesystem::path& log, double limit_s);
 
