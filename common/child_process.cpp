@@ -7,12 +7,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <new>
+#include <optional>
 #include <thread>
 
 #include "common/error.hpp"
@@ -208,21 +210,39 @@ std::optional<Reaped> poll_any() {
   }
 }
 
+namespace {
+// State and parent of a process from /proc/<pid>/stat (nullopt when it is gone).
+struct ProcStat {
+  char state = 0;
+  pid_t ppid = 0;
+};
+std::optional<ProcStat> proc_stat(const fs::path& stat_file) {
+  std::FILE* f = std::fopen(stat_file.c_str(), "r");
+  if (!f) return std::nullopt;
+  char buf[512];
+  const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+  std::fclose(f);
+  buf[n] = 0;
+  const char* close = std::strrchr(buf, ')');  // the command name may hold spaces
+  ProcStat s;
+  if (!close || std::sscanf(close + 1, " %c %d", &s.state, &s.ppid) != 2) return std::nullopt;
+  return s;
+}
+
+// Not gone and not a zombie (an orphan's zombie waits for init).
+bool running(pid_t pid) {
+  const auto s = proc_stat("/proc/" + std::to_string(pid) + "/stat");
+  return s && s->state != 'Z' && s->state != 'X';
+}
+}  // namespace
+
 std::vector<pid_t> descendants(pid_t root) {
   std::vector<std::pair<pid_t, pid_t>> procs;  // pid, ppid
   std::error_code ec;
   for (const auto& e : fs::directory_iterator("/proc", ec)) {
     const std::string name = e.path().filename().string();
     if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::FILE* f = std::fopen((e.path() / "stat").c_str(), "r");
-    if (!f) continue;
-    char buf[512];
-    const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
-    std::fclose(f);
-    buf[n] = 0;
-    const char* close = std::strrchr(buf, ')');  // the command name may hold spaces
-    int ppid = 0;
-    if (close && std::sscanf(close + 1, " %*c %d", &ppid) == 1) procs.emplace_back(std::stoi(name), ppid);
+    if (const auto s = proc_stat(e.path() / "stat")) procs.emplace_back(std::stoi(name), s->ppid);
   }
   std::vector<pid_t> out{root};
   for (std::size_t i = 0; i < out.size(); ++i)
@@ -239,20 +259,34 @@ void signal_family(pid_t pid, int sig) {
 }
 
 void stop_and_reap(const std::vector<pid_t>& pids, double grace_s) {
-  std::vector<pid_t> live = pids;
+  // The family as wait_with_limit sees it: each child's group and every descendant,
+  // which may sit in groups of their own (a cohort worker's stages) and would
+  // otherwise outlive their parent's SIGKILL, holding its work folder's lock.
+  std::vector<pid_t> live = pids, family;
+  auto gather = [&] {
+    for (pid_t p : live)
+      for (pid_t d : descendants(p))
+        if (std::find(family.begin(), family.end(), d) == family.end()) family.push_back(d);
+  };
+  gather();
   for (pid_t p : live) ::kill(-p, SIGTERM);
+  for (pid_t d : family) ::kill(d, SIGTERM);
   const auto start = std::chrono::steady_clock::now();
   bool killed = false;
-  while (!live.empty()) {
+  for (;;) {
+    if (!killed) gather();  // before reaping: a reaped child's descendants are init's
     std::erase_if(live, [](pid_t p) {
       int status = 0;
       const pid_t w = ::waitpid(p, &status, WNOHANG);
       return w == p || (w < 0 && errno == ECHILD);  // reaped, or not ours to wait for
     });
-    if (live.empty()) break;
+    std::erase_if(family, [](pid_t d) { return !running(d); });
+    // Descendants left behind by a child that ended on SIGTERM get the same grace.
+    if (live.empty() && (killed || family.empty())) break;
     if (!killed && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > grace_s) {
       killed = true;
       for (pid_t p : live) ::kill(-p, SIGKILL);
+      for (pid_t d : family) ::kill(d, SIGKILL);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

@@ -123,11 +123,12 @@ void probe_read_in_child(const std::filesystem::path& file, const std::string& w
 /// short (the command is in a group of its own, out of reach of a Ctrl-C).
 CapturedRun run_captured(const std::vector<std::string>& argv, const ChildSetup& setup = {});
 
-/// Ends children on an error path (a runner that cannot go on): SIGTERM to each
-/// child's process group, SIGKILL to the groups of those still running
-/// `grace_s` later (a stage stuck in a library that ignores SIGTERM), and
-/// returns once every one of them is reaped.
-void stop_and_reap(const std::vector<pid_t>& pids, double grace_s = 10.0);
+/// Ends children when a runner cannot go on (an error, or a study's stop):
+/// SIGTERM to each child's process group and every descendant (in whatever
+/// group), SIGKILL to those still running `grace_s` later (a stage stuck in a
+/// library that ignores SIGTERM); returns once every child is reaped and every
+/// descendant has ended or been killed.
+void stop_and_reap(const std::vector<pid_t>& pids, double grace_s = 30.0);
 
 /// Sends `sig` to the child's process group and to every live descendant.
 void signal_family(pid_t pid, int sig);

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <thread>
 
@@ -89,22 +90,52 @@ TEST(PipelineChildProcess, ExecFailureSignalAndTiming) {
   fs::remove_all(d);
 }
 
-// The error path of a runner: a child that ignores SIGTERM (a stage stuck in a
-// library) is killed after the grace period; both are reaped.
-TEST(PipelineChildProcess, StopAndReapKillsAChildThatIgnoresTerm) {
-  const pid_t stubborn = spawn_exec({"sh", "-c", "trap '' TERM; sleep 30; exit 0"});
+namespace {
+// Not gone and not a zombie (/proc/<pid>/stat's state).
+bool still_running(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat((std::istreambuf_iterator<char>(in)), {});
+  const auto close = stat.rfind(')');
+  return close != std::string::npos && close + 2 < stat.size() && stat[close + 2] != 'Z' && stat[close + 2] != 'X';
+}
+
+bool wait_for_file(const fs::path& f) {
+  for (int i = 0; i < 500 && !fs::exists(f); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  return fs::exists(f);
+}
+}  // namespace
+
+// A runner that cannot go on: a child that ignores SIGTERM (a stage stuck in a library)
+// is killed after the grace period, and so is the grandchild that a child which ended
+// on SIGTERM left behind in a session of its own (a cohort worker's stage); every child
+// is reaped.
+TEST(PipelineChildProcess, StopAndReapEndsChildrenAndTheirDescendants) {
+  const fs::path d = fresh_dir("reap");
+  const pid_t stubborn = spawn_exec({"sh", "-c", "trap '' TERM; touch " + (d / "trapped").string() + "; sleep 30"});
+  const std::string g = (d / "grandchild").string();
+  const pid_t leaver = spawn_exec(
+      {"sh", "-c", "setsid sh -c 'trap \"\" TERM; echo $$ > " + g + ".tmp; mv " + g + ".tmp " + g + "; sleep 30' & wait"});
   const pid_t polite = spawn_exec({"sleep", "30"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the trap is set
+  ASSERT_TRUE(wait_for_file(d / "trapped"));
+  ASSERT_TRUE(wait_for_file(g));
+  const pid_t grandchild = std::stoi(read(g));
+  ASSERT_TRUE(still_running(grandchild));
   const auto start = std::chrono::steady_clock::now();
-  stentsim::process::stop_and_reap({stubborn, polite}, 0.5);
+  stentsim::process::stop_and_reap({stubborn, leaver, polite}, 0.5);
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_GE(took, 0.5);  // the stubborn one outlived SIGTERM
+  EXPECT_GE(took, 0.5);  // the stubborn ones outlived SIGTERM
   EXPECT_LT(took, 10.0);
-  for (const pid_t p : {stubborn, polite}) {
+  for (const pid_t p : {stubborn, leaver, polite}) {
     errno = 0;
-    EXPECT_EQ(::waitpid(p, nullptr, WNOHANG), -1);
-    EXPECT_EQ(errno, ECHILD);  // already reaped
+    const pid_t w = ::waitpid(p, nullptr, WNOHANG);
+    const int err = errno;
+    EXPECT_EQ(w, -1);
+    EXPECT_EQ(err, ECHILD);  // already reaped
   }
+  bool gone = false;
+  for (int i = 0; i < 100 && !gone; ++i, std::this_thread::sleep_for(std::chrono::milliseconds(20))) gone = !still_running(grandchild);
+  EXPECT_TRUE(gone) << "the grandchild " << grandchild << " in a session of its own outlived stop_and_reap";
+  fs::remove_all(d);
 }
 
 TEST(PipelineChildProcess, BodyRunsInItsOwnProcessGroup) {

@@ -15,6 +15,7 @@
 
 #include "common/child_process.hpp"
 #include "common/files.hpp"
+#include "pipeline/manifest.hpp"
 #include "tests/workflows/cli_runner.hpp"
 #include "workflows/cohort/cohort_plots.hpp"
 #include "workflows/cohort/cohort_runner.hpp"
@@ -405,14 +406,16 @@ TEST(CohortEta, MedianStageTimesOverRemainingWork) {
   EXPECT_DOUBLE_EQ(*cohort_eta(samples, {{}, {}, {}}, 0), 21.0);  // at least one at a time
 }
 
-// A case whose manifest cannot be read fails alone, with the reason; the pool
-// (and the Slurm follower) that asks goes on with the other cases.
+// A case whose manifest cannot be read fails alone, with the reason, where the
+// manifest decides its outcome; what the exit status says alone (a crash, a refused
+// case file, an interrupt) stays as it is.
 TEST(CohortOutcome, AnUnreadableManifestFailsItsCaseAndNothingElse) {
   using namespace stentsim::workflows;
   const fs::path dir = fs::temp_directory_path() / ("stentsim-cohort-outcome-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "a" / "work");
-  stentsim::files::write_atomic(dir / "a" / "work" / "manifest.yaml", "stages: {centerline: [unclosed\n");
+  const fs::path manifest = dir / "a" / "work" / "manifest.yaml";
+  stentsim::files::write_atomic(manifest, "stages: {centerline: [unclosed\n");
   stentsim::files::write_atomic(dir / "a" / "run.log", "error: mesh: the wall is inside the lumen\n");
   CohortConfig c;
   c.work_dir = dir;
@@ -422,19 +425,37 @@ TEST(CohortOutcome, AnUnreadableManifestFailsItsCaseAndNothingElse) {
   ASSERT_NO_THROW(r = case_outcome(c, k, 1, 2.0));
   EXPECT_EQ(r.status, "failed");
   EXPECT_EQ(r.error_kind, "unknown");
-  EXPECT_NE(r.manifest_error.find((dir / "a" / "work" / "manifest.yaml").string() + ": unreadable"), std::string::npos)
-      << r.manifest_error;
+  EXPECT_NE(r.manifest_error.find(manifest.string()), std::string::npos) << r.manifest_error;
+  EXPECT_NE(r.message.find(manifest.string()), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("the wall is inside the lumen"), std::string::npos) << r.message;
-  // A run that succeeded is only asked about its manifest when a stage was meant to fail.
+  // Known from the exit status: a killed worker, a case file `stentsim run` refused.
+  r = case_outcome(c, k, 128 + 9, 2.0);
+  EXPECT_EQ(r.error_kind, "crash");
+  EXPECT_NE(r.message.find("killed by signal 9"), std::string::npos) << r.message;
+  EXPECT_EQ(case_outcome(c, k, 2, 2.0).error_kind, "input");
+  // An interrupted run's manifest is not asked at all.
+  r = case_outcome(c, k, 130, 2.0);
+  EXPECT_EQ(r.status, "interrupted");
+  EXPECT_TRUE(r.manifest_error.empty()) << r.manifest_error;
+  // A run that succeeded is asked only when a stage was meant to fail.
   EXPECT_EQ(case_outcome(c, k, 0, 2.0).status, "done");
   k.expect_failure = "placement";
-  EXPECT_EQ(case_outcome(c, k, 0, 2.0).status, "failed");
-  EXPECT_EQ(case_outcome(c, k, 130, 2.0).status, "interrupted");
-  // Readable again: the usual outcome.
-  fs::remove(dir / "a" / "work" / "manifest.yaml");
-  EXPECT_EQ(case_outcome(c, k, 1, 2.0).status, "failed");
-  EXPECT_TRUE(case_outcome(c, k, 1, 2.0).manifest_error.empty());
-  EXPECT_EQ(case_outcome(c, k, 0, 2.0).status, "done");
+  r = case_outcome(c, k, 0, 2.0);
+  EXPECT_EQ(r.status, "failed");
+  EXPECT_NE(r.message.find("whether stage placement ran is unknown"), std::string::npos) << r.message;
+  // Readable again, with placement failed as the case declares.
+  stentsim::pipeline::Manifest m;
+  stentsim::pipeline::StageRecord failed;
+  failed.status = "failed";
+  failed.error_kind = stentsim::pipeline::ErrorKind::input;
+  failed.message = "the device does not fit";
+  m.set("placement", failed);
+  m.save(manifest);
+  r = case_outcome(c, k, 1, 2.0);
+  EXPECT_EQ(r.status, "failed as expected");
+  EXPECT_EQ(r.failed_stage, "placement");
+  EXPECT_EQ(r.error_kind, "input");
+  EXPECT_TRUE(r.manifest_error.empty()) << r.manifest_error;
   fs::remove_all(dir);
 }
 

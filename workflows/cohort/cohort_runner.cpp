@@ -129,31 +129,37 @@ CaseOutcome case_outcome(const CohortConfig& c, const CohortCase& k, int exit_co
   r.wall_s = wall_s;
   r.exit_code = exit_code;
   const fs::path manifest = dir / "work" / "manifest.yaml";
-  // An unreadable manifest (damaged, a permission, a shared file system that shows a
-  // rewrite half done) is this case's failure, never the pool's: the other cases go on.
+  // The manifest is read only where it decides something: which stage failed, or
+  // whether the stage meant to fail ran. An interrupted run's may be an earlier run's.
+  // An unreadable one (damaged, a permission, a shared file system that shows a rewrite
+  // half done) is this case's failure, never the pool's: the other cases go on.
   std::optional<pipeline::StageRecord> failed;
   bool expected_stage_ran = false;
   try {
-    if (r.exit_code) failed = failed_record(manifest, r.failed_stage);
-    else if (k.expect_failure) expected_stage_ran = stage_succeeded(manifest, *k.expect_failure);
+    if (r.exit_code && r.exit_code != 130) failed = failed_record(manifest, r.failed_stage);
+    else if (r.exit_code == 0 && k.expect_failure) expected_stage_ran = stage_succeeded(manifest, *k.expect_failure);
   } catch (const std::exception& e) {
-    r.manifest_error = fmt::format("{}: unreadable ({})", manifest.string(), e.what());
+    r.manifest_error = e.what();  // names the file
   }
   r.error_kind = error_kind_of(r.exit_code, failed);
-  if (!r.manifest_error.empty() && r.exit_code != 130) {
+  if (!r.manifest_error.empty()) {
     r.status = "failed";
-    r.error_kind = "unknown";
-    r.message = r.manifest_error;
-    if (r.exit_code) r.message += "; log: " + failure_message(dir / "run.log");
-    return r;
-  }
-  if (r.exit_code == 0)
+    // A crash or a refused case file (exit 2, a damaged manifest among them) is known from
+    // the exit status alone; which stage failed, or whether the expected one ran, is not.
+    if (r.exit_code == 0 || (r.exit_code != 2 && r.exit_code <= 128)) r.error_kind = "unknown";
+    r.message = r.exit_code == 0 ? fmt::format("the run succeeded but whether stage {} ran is unknown: {}", *k.expect_failure,
+                                               r.manifest_error)
+                                 : r.manifest_error;
+  } else if (r.exit_code == 0)
     // With --until/--only the stage meant to fail may not have run: then "done".
     r.status = expected_stage_ran ? "succeeded unexpectedly" : "done";
   else if (r.exit_code == 130) r.status = "interrupted";  // before the manifest, which may be an earlier run's
   else if (k.expect_failure && r.failed_stage == *k.expect_failure) r.status = "failed as expected";
   else r.status = "failed";
-  if (r.exit_code) r.message = failure_message(dir / "run.log");
+  if (r.exit_code) {
+    const std::string log = failure_message(dir / "run.log");
+    r.message = r.message.empty() ? log : log.empty() ? r.message : r.message + "; log: " + log;
+  }
   if (r.exit_code > 128 && r.exit_code != 130)  // the worker itself was killed: its log cannot say so
     r.message = fmt::format("stentsim run killed by signal {} ({}){}", r.exit_code - 128, strsignal(r.exit_code - 128),
                             r.message.empty() ? "" : "; log: " + r.message);
@@ -456,7 +462,18 @@ void add_unselected_cases(const CohortConfig& c, CohortReport& r) {
         o.status = "not run";
         o.exit_code = -1;
       } else {
-        const auto failed = failed_record(manifest, o.failed_stage);
+        std::optional<pipeline::StageRecord> failed;
+        try {
+          failed = failed_record(manifest, o.failed_stage);
+        } catch (const std::exception& e) {  // this case's row says so; the summary is still written
+          o.failed_stage.clear();
+          o.status = "failed";
+          o.exit_code = -1;
+          o.error_kind = "unknown";
+          o.message = e.what();
+          r.cases.push_back(o);
+          continue;
+        }
         if (failed) o.error_kind = pipeline::to_string(failed->error_kind);
         if (o.failed_stage.empty()) o.status = "done";
         else {

@@ -30,10 +30,11 @@ struct CaseOutcome {
   std::string failed_stage;  // from the case's manifest
   /// Why it failed (empty when it did not): the failed stage's kind from the manifest
   /// (input: a bad input file or setting, compute, crash, unknown), input for a case file
-  /// `stentsim run` refused (exit 2), crash for a killed worker, interrupted, lost (Slurm).
+  /// `stentsim run` refused (exit 2), crash for a killed worker, interrupted, lost (Slurm),
+  /// unknown when the manifest that would say could not be read.
   std::string error_kind;
   std::string message;       // last lines of the case's log on failure
-  std::string manifest_error;  // why the case's manifest could not be read (empty: it could); status failed then
+  std::string manifest_error;  // why the case's manifest, needed for its outcome, could not be read (empty: it could); status failed then
   int exit_code = 0;         // the case's `stentsim run`: its exit status, 128 + signal when killed, -1 unknown (lost)
   double wall_s = 0;
   bool as_expected() const { return status == "done" || status == "failed as expected"; }

@@ -209,10 +209,14 @@ bool up_to_date(const CohortConfig& c, const CohortCase& k, const fs::path& case
   const CaseOutcome o = case_outcome(c, k, *rc, 0);
   if (!o.as_expected()) return false;
   const auto cc = load_case(case_file);
-  pipeline::Runner runner(pipeline::Plan(stages_for(cc), cc.work_dir), kVersion);
-  for (const auto& s : runner.status()) {
-    if (s.state == pipeline::StageState::stale) return false;
-    if (s.state == pipeline::StageState::failed && o.status != "failed as expected") return false;
+  try {
+    pipeline::Runner runner(pipeline::Plan(stages_for(cc), cc.work_dir), kVersion);
+    for (const auto& s : runner.status()) {
+      if (s.state == pipeline::StageState::stale) return false;
+      if (s.state == pipeline::StageState::failed && o.status != "failed as expected") return false;
+    }
+  } catch (const std::exception&) {
+    return false;  // a manifest that cannot be read: submit the case again, whose run reports it
   }
   return true;
 }
@@ -466,7 +470,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
   };
   std::vector<Follow> follow;
   const auto now = std::chrono::steady_clock::now();
-  for (const std::size_t i : attach) follow.push_back({i, now, {}});
+  for (const std::size_t i : attach) follow.push_back({i, now, {}, {}});
   auto active_tasks = [&] {
     std::vector<std::string> ids;
     for (const auto& f : follow)
@@ -513,7 +517,7 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
       for (std::size_t t = 0; t < submit.size(); ++t) {
         TaskRecord rec{job + "_" + std::to_string(t), job, sdir / fmt::format("slurm-{}_{}.out", job, t), o.run_args, when};
         tasks[c.cases[submit[t]].id] = rec;
-        follow.push_back({submit[t], std::chrono::steady_clock::now(), {}});
+        follow.push_back({submit[t], std::chrono::steady_clock::now(), {}, {}});
       }
       save_tasks(c, tasks);
       out << fmt::format("submitted job array {} ({} task(s) of {} rank(s) x {} cpu(s)): {}\n", job, ids.size(),
@@ -548,7 +552,8 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
     // squeue failing for a while (the controller restarting, a network blip) is waited
     // out; only a long outage ends the follower, and then the tasks keep running.
     const double queue_patience = c.slurm.queue_patience_s;
-    std::optional<std::chrono::steady_clock::time_point> queue_failing;
+    bool queue_failing = false;
+    std::chrono::steady_clock::time_point queue_failing_since;
     while (!process::StopSignals::received() && std::any_of(follow.begin(), follow.end(), [](const Follow& f) { return !f.finished; })) {
       std::set<std::string> live;
       for (const auto& f : follow)
@@ -557,16 +562,17 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
       try {
         st = task_states(live);
         if (queue_failing) out << "slurm: squeue answers again\n";
-        queue_failing.reset();
+        queue_failing = false;
       } catch (const ComputeError& e) {
         const auto now = std::chrono::steady_clock::now();
         if (!queue_failing) {
-          queue_failing = now;
+          queue_failing = true;
+          queue_failing_since = now;
           out << fmt::format("{}; trying again for up to {:.0f} s\n", e.what(), queue_patience);
           out.flush();
         }
-        const double failing_s = std::chrono::duration<double>(now - *queue_failing).count();
-        if (failing_s > queue_patience)
+        const double failing_s = std::chrono::duration<double>(now - queue_failing_since).count();
+        if (failing_s >= queue_patience)
           throw QueueUnreachable(fmt::format("{} (for {:.0f} s); the submitted tasks were left to run: follow them with "
                                              "`stentsim cohort status {}`", e.what(), failing_s, c.file.string()));
         sleep_interruptibly(c.slurm.poll_interval_s);
@@ -640,7 +646,13 @@ CohortReport run_cohort_slurm(const CohortConfig& c, const CohortRunOptions& o_i
     for (const auto& f : follow)
       if (!f.finished) live.insert(tasks.at(c.cases[f.index].id).array);
     for (int i = 0; i < 100; ++i) {
-      const auto st = task_states(live);
+      std::map<std::string, std::string> st;
+      try {
+        st = task_states(live);
+      } catch (const ComputeError& e) {  // the queue is down: the cancel cannot be confirmed, the stop stands
+        out << fmt::format("{}; the cancel of {} task(s) is not confirmed\n", e.what(), ids.size());
+        break;
+      }
       if (std::none_of(ids.begin(), ids.end(), [&](const std::string& id) {
             auto s = st.find(id);
             return s != st.end() && active_state(s->second);

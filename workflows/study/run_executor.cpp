@@ -256,6 +256,9 @@ ExecStats execute_runs(const StudyConfig& study, const StudyPlan& plan, const fs
       finish(done, ok, why);
     }
   } catch (...) {
+    // A stop (Interrupted) or an error: the running runs get SIGTERM (each `stentsim run`
+    // stops its stage and keeps what finished) and SIGKILL only if one is still running
+    // after stop_and_reap's grace.
     std::vector<pid_t> pids;
     for (const auto& [pid, r] : running) pids.push_back(pid);
     process::stop_and_reap(pids);
