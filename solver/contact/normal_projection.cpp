@@ -53,9 +53,12 @@ NormalProjection project_along_normals(const ContactSurface& s, int face, const 
     // Singular when det J is round-off against Hadamard's bound |det J| <= Π |J_k| (a
     // scale-free test; the adjugate inverse of a 3 x 3 costs a fraction of a pivoted LU,
     // and this loop runs for every Gauss point and candidate face of every assembly).
-    const double det = J.determinant();
-    if (!(std::abs(det) > 1e-13 * J.col(0).norm() * J.col(1).norm() * J.col(2).norm())) return r;
-    const Vec3 dy = -(J.inverse() * F);
+    Mat3 inv;
+    double det = 0.0;
+    bool nonzero = false;
+    J.computeInverseAndDetWithCheck(inv, det, nonzero, 0.0);  // det and cofactors once
+    if (!nonzero || !(std::abs(det) > 1e-13 * J.col(0).norm() * J.col(1).norm() * J.col(2).norm())) return r;
+    const Vec3 dy = -(inv * F);
     xi[0] += dy[0], xi[1] += dy[1], alpha += dy[2];
     if (!std::isfinite(alpha) || std::abs(xi[0]) > 1e3 || std::abs(xi[1]) > 1e3) return r;
     if (F.norm() <= tol && dy.head<2>().norm() <= 1e-12) {
