@@ -1,6 +1,7 @@
 #include "common/child_process.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <fmt/format.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -18,6 +20,7 @@
 #include <thread>
 
 #include "common/error.hpp"
+#include "common/log.hpp"
 
 namespace fs = std::filesystem;
 
@@ -145,7 +148,7 @@ pid_t spawn_exec(const std::vector<std::string>& argv_s, const ChildSetup& setup
   return spawn_with_output([&a]() -> int { return exec_body(a); }, without_env, -1);
 }
 
-CapturedRun run_captured(const std::vector<std::string>& argv_s, const ChildSetup& setup) {
+CapturedRun run_captured(const std::vector<std::string>& argv_s, const ChildSetup& setup, double limit_s, double grace_s) {
   if (argv_s.empty()) throw ComputeError("cannot start a child process: empty command");
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw ComputeError(fmt::format("cannot start {}: pipe failed: {}", argv_s[0], std::strerror(errno)));
@@ -164,18 +167,36 @@ CapturedRun run_captured(const std::vector<std::string>& argv_s, const ChildSetu
   ::close(fds[1]);
   CapturedRun r;
   char buf[4096];
+  // Read until the command (and whatever inherited its output) closes the pipe, or its
+  // time is up: a descendant that keeps the pipe open must not hold the caller either.
   for (;;) {
+    int wait_ms = -1;
+    if (limit_s > 0.0) {
+      const double left = limit_s - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (left <= 0.0) break;
+      wait_ms = static_cast<int>(std::ceil(left * 1000.0));
+    }
+    pollfd pf{fds[0], POLLIN, 0};
+    const int ready = ::poll(&pf, 1, wait_ms);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready <= 0) break;  // timed out (0), or poll failed: the wait below decides
     const ssize_t n = ::read(fds[0], buf, sizeof buf);
     if (n > 0) r.output.append(buf, static_cast<std::size_t>(n));
     else if (n < 0 && errno == EINTR) continue;
     else break;
   }
   ::close(fds[0]);
-  int status = 0;
-  rusage ru{};
-  while (::wait4(pid, &status, 0, &ru) < 0)
-    if (errno != EINTR) throw ComputeError(fmt::format("waiting for {} failed: {}", argv_s[0], std::strerror(errno)));
-  r.end = child_end(status, ru, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  Reaped end;
+  end.pid = ::wait4(pid, &end.wait_status, limit_s > 0.0 ? WNOHANG : 0, &end.usage);
+  while (end.pid < 0 && errno == EINTR) end.pid = ::wait4(pid, &end.wait_status, limit_s > 0.0 ? WNOHANG : 0, &end.usage);
+  if (end.pid < 0) throw ComputeError(fmt::format("waiting for {} failed: {}", argv_s[0], std::strerror(errno)));
+  if (end.pid == 0) {
+    // Still running at its limit, or it closed its output and goes on: a short wait, then it is ended.
+    const ChildEnd e = wait_with_limit(pid, start, limit_s, grace_s);
+    r.end = e;
+    return r;
+  }
+  r.end = child_end(end.wait_status, end.usage, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return r;
 }
 
@@ -258,73 +279,77 @@ void signal_family(pid_t pid, int sig) {
   for (pid_t d : family) ::kill(d, sig);
 }
 
-void stop_and_reap(const std::vector<pid_t>& pids, double grace_s) {
-  // The family as wait_with_limit sees it: each child's group and every descendant,
-  // which may sit in groups of their own (a cohort worker's stages) and would
-  // otherwise outlive their parent's SIGKILL, holding its work folder's lock.
+std::vector<Reaped> stop_and_reap(const std::vector<pid_t>& pids, double grace_s, double stuck_s) {
+  // The family as each child leaves it: its group and every descendant, which may sit in
+  // groups of their own (a cohort worker's stages) and would otherwise outlive their
+  // parent's SIGKILL, holding its work folder's lock.
   std::vector<pid_t> live = pids, family;
+  std::vector<Reaped> reaped;
   auto gather = [&] {
     for (pid_t p : live)
       for (pid_t d : descendants(p))
         if (std::find(family.begin(), family.end(), d) == family.end()) family.push_back(d);
   };
+  auto signal_all = [&](int sig) {
+    for (pid_t p : live) ::kill(-p, sig);
+    for (pid_t d : family) ::kill(d, sig);
+  };
   gather();
-  for (pid_t p : live) ::kill(-p, SIGTERM);
-  for (pid_t d : family) ::kill(d, SIGTERM);
+  signal_all(SIGTERM);
   const auto start = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point kill_time;
   bool killed = false;
   for (;;) {
     if (!killed) gather();  // before reaping: a reaped child's descendants are init's
-    std::erase_if(live, [](pid_t p) {
-      int status = 0;
-      const pid_t w = ::waitpid(p, &status, WNOHANG);
-      return w == p || (w < 0 && errno == ECHILD);  // reaped, or not ours to wait for
+    std::erase_if(live, [&](pid_t p) {
+      Reaped r;
+      r.pid = ::wait4(p, &r.wait_status, WNOHANG, &r.usage);
+      if (r.pid == p) reaped.push_back(r);
+      return r.pid == p || (r.pid < 0 && errno == ECHILD);  // reaped, or not ours to wait for
     });
     std::erase_if(family, [](pid_t d) { return !running(d); });
     // Descendants left behind by a child that ended on SIGTERM get the same grace.
     if (live.empty() && (killed || family.empty())) break;
-    if (!killed && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > grace_s) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!killed && std::chrono::duration<double>(now - start).count() > grace_s) {
       killed = true;
-      for (pid_t p : live) ::kill(-p, SIGKILL);
-      for (pid_t d : family) ::kill(d, SIGKILL);
+      kill_time = now;
+      signal_all(SIGKILL);
+    } else if (killed && std::chrono::duration<double>(now - kill_time).count() > stuck_s) {
+      // SIGKILL takes effect when a process leaves the kernel: one in uninterruptible sleep
+      // (state D: a hung network file system) can stay there indefinitely, and waiting for
+      // it would hang the caller's own way out.
+      std::string who;
+      for (pid_t p : live) who += fmt::format(" {}", p);
+      for (pid_t d : family) who += fmt::format(" {}", d);
+      log::warn("processes{} did not end {:.0f} s after SIGKILL (uninterruptible sleep?); going on without them", who, stuck_s);
+      break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  return reaped;
 }
 
 ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start, double limit_s, double grace_s) {
-  int status = 0;
-  rusage ru{};
-  bool timed_out = false;
-  std::chrono::steady_clock::time_point term_time;
-  std::vector<pid_t> family;  // the child's descendants when it was stopped
+  Reaped r;
   for (;;) {
-    const pid_t w = ::wait4(pid, &status, WNOHANG, &ru);
-    if (w == pid) break;
-    if (w < 0 && errno != EINTR) throw ComputeError(fmt::format("waiting for process {} failed: {}", pid, std::strerror(errno)));
-    const auto now = std::chrono::steady_clock::now();
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    if (!timed_out && elapsed > limit_s) {
-      timed_out = true;
-      family = descendants(pid);
-      ::kill(-pid, SIGTERM);
-      for (pid_t d : family) ::kill(d, SIGTERM);
-      term_time = now;
-    } else if (timed_out && std::chrono::duration<double>(now - term_time).count() > grace_s) {
-      for (pid_t d : descendants(pid)) family.push_back(d);
-      ::kill(-pid, SIGKILL);
-      for (pid_t d : family) ::kill(d, SIGKILL);
+    r.pid = ::wait4(pid, &r.wait_status, WNOHANG, &r.usage);
+    if (r.pid == pid) break;
+    if (r.pid < 0 && errno != EINTR) throw ComputeError(fmt::format("waiting for process {} failed: {}", pid, std::strerror(errno)));
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (elapsed > limit_s) {
+      // Timed out: the child, its group and its descendants (a stage it started) end.
+      const std::vector<Reaped> ended = stop_and_reap({pid}, grace_s);
+      ChildEnd e;
+      if (!ended.empty()) e = child_end(ended.front().wait_status, ended.front().usage, 0.0);
+      else e.signal = SIGKILL;  // not reaped: stuck after SIGKILL (stop_and_reap warned)
+      e.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      e.timed_out = true;
+      return e;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(elapsed < 1 ? 5 : 50));
   }
-  // Grandchildren left behind (a stage the child started) go with it.
-  if (timed_out) {
-    ::kill(-pid, SIGKILL);
-    for (pid_t d : family) ::kill(d, SIGKILL);
-  }
-  ChildEnd e = child_end(status, ru, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  e.timed_out = timed_out;
-  return e;
+  return child_end(r.wait_status, r.usage, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
 namespace {

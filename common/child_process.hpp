@@ -121,14 +121,20 @@ void probe_read_in_child(const std::filesystem::path& file, const std::string& w
 /// returns its stdout and stderr together: for short commands whose answer
 /// the caller parses (sbatch, squeue). A stop signal does not cut the wait
 /// short (the command is in a group of its own, out of reach of a Ctrl-C).
-CapturedRun run_captured(const std::vector<std::string>& argv, const ChildSetup& setup = {});
+/// A command still running after `limit_s` (0: no limit) is ended as
+/// stop_and_reap ends a child (SIGTERM, SIGKILL `grace_s` later) and returns
+/// timed out, with what it wrote until then.
+CapturedRun run_captured(const std::vector<std::string>& argv, const ChildSetup& setup = {}, double limit_s = 0.0,
+                         double grace_s = 2.0);
 
-/// Ends children when a runner cannot go on (an error, or a study's stop):
-/// SIGTERM to each child's process group and every descendant (in whatever
-/// group), SIGKILL to those still running `grace_s` later (a stage stuck in a
-/// library that ignores SIGTERM); returns once every child is reaped and every
-/// descendant has ended or been killed.
-void stop_and_reap(const std::vector<pid_t>& pids, double grace_s = 30.0);
+/// Ends children when a runner cannot go on (an error, a study's stop, a time
+/// limit): SIGTERM to each child's process group and every descendant (in
+/// whatever group), SIGKILL to those still running `grace_s` later (a stage stuck
+/// in a library that ignores SIGTERM); returns once every child is reaped and
+/// every descendant has ended, with each reaped child's status. Processes that
+/// outlast their SIGKILL by `stuck_s` (uninterruptible sleep on a hung file
+/// system) are named in a warning and left: a child among them has no entry.
+std::vector<Reaped> stop_and_reap(const std::vector<pid_t>& pids, double grace_s = 30.0, double stuck_s = 10.0);
 
 /// Sends `sig` to the child's process group and to every live descendant.
 void signal_family(pid_t pid, int sig);

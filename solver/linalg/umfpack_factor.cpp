@@ -94,6 +94,9 @@ void UmfpackFactor::factor(const CsrMatrix& a) {
     throw std::runtime_error("UMFPACK factorization failed: " + umfpack_status_text(st));
   }
   rows_ = a.rows;
+  log::debug("UMFPACK factorization: nnz(L + U) = {:.0f}, {:.0f} MB, {:.3g} Gflop, {:.3f} s", info_[UMFPACK_LNZ] + info_[UMFPACK_UNZ],
+             info_[UMFPACK_NUMERIC_SIZE] * info_[UMFPACK_SIZE_OF_UNIT] / 1e6, info_[UMFPACK_FLOPS] / 1e9,
+             std::chrono::duration<double>(Clock::now() - t0).count());
 }
 
 void UmfpackFactor::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {

@@ -185,6 +185,43 @@ TEST(PipelineChildProcess, RunCapturedReturnsBothStreamsAndTheStatus) {
   EXPECT_THROW(run_captured({}), stentsim::ComputeError);
 }
 
+// A command that does not answer (a hung squeue) is ended at its limit, SIGKILL for one
+// that ignores SIGTERM, with what it wrote so far; a descendant that keeps the output
+// pipe open after the command exited holds the caller no longer than the limit, and the
+// command's own status is kept.
+TEST(PipelineChildProcess, RunCapturedEndsACommandAtItsLimit) {
+  using Clock = std::chrono::steady_clock;
+  auto t0 = Clock::now();
+  const CapturedRun hung = run_captured({"sh", "-c", "trap '' TERM; echo asked; sleep 30"}, {}, 0.5, 0.3);
+  double took = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_TRUE(hung.end.timed_out) << hung.end.describe();
+  EXPECT_EQ(hung.end.signal, SIGKILL) << hung.end.describe();
+  EXPECT_EQ(hung.output, "asked\n");
+  EXPECT_GE(took, 0.8);  // the limit, then the grace SIGTERM could not shorten
+  EXPECT_LT(took, 10.0);
+  t0 = Clock::now();
+  const CapturedRun left = run_captured({"sh", "-c", "sleep 30 & echo done; exit 3"}, {}, 1.0);
+  took = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_FALSE(left.end.timed_out) << left.end.describe();
+  EXPECT_EQ(left.end.exit_code, 3);
+  EXPECT_EQ(left.output, "done\n");
+  EXPECT_LT(took, 10.0);
+  const CapturedRun quick = run_captured({"sh", "-c", "echo fast"}, {}, 30.0);
+  EXPECT_TRUE(quick.end.ok()) << quick.end.describe();
+  EXPECT_EQ(quick.output, "fast\n");
+}
+
+// wait_with_limit ends a child at its limit through stop_and_reap, and the child's own end
+// (here SIGTERM, which it does not ignore) is what it reports.
+TEST(PipelineChildProcess, WaitWithLimitReportsTheSignalThatEndedATimedOutChild) {
+  const auto start = std::chrono::steady_clock::now();
+  const ChildEnd e = wait_with_limit(spawn_exec({"sleep", "30"}), start, 0.3, 5.0);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_TRUE(e.timed_out);
+  EXPECT_EQ(e.signal, SIGTERM) << e.describe();
+  EXPECT_LT(took, 4.0);  // SIGTERM was enough: no wait for the grace
+}
+
 TEST(PipelineChildProcess, AChildReadsNoTerminal) {
   // stdin is /dev/null: a read ends at once (a background group reading the
   // terminal would be stopped by SIGTTIN and its parent wait for ever).

@@ -56,10 +56,18 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
+// A Slurm command's time to answer: slurmctld answers in well under a second when it
+// is up; one that hangs (a controller failing over, a stalled RPC) must not hang the
+// follower, which then waits out slurm.queue_patience_s as for a failed squeue.
+constexpr double kCommandLimitS = 120.0;
+
 // Runs a Slurm command (no shell) and captures its output; code is the exit
-// status, 128 + the signal that ended it.
+// status, 128 + the signal that ended it, 124 (as timeout(1)) when it did not
+// answer within kCommandLimitS.
 CommandResult run_command(const std::vector<std::string>& argv) {
-  const auto run = process::run_captured(argv);
+  const auto run = process::run_captured(argv, {}, kCommandLimitS);
+  if (run.end.timed_out)
+    return {124, run.output + fmt::format("{}(no answer within {:.0f} s)", run.output.empty() ? "" : "\n", kCommandLimitS)};
   return {run.end.signal ? 128 + run.end.signal : run.end.exit_code, run.output};
 }
 
