@@ -169,34 +169,54 @@ CapturedRun run_captured(const std::vector<std::string>& argv_s, const ChildSetu
   char buf[4096];
   // Read until the command (and whatever inherited its output) closes the pipe, or its
   // time is up: a descendant that keeps the pipe open must not hold the caller either.
+  bool hit_limit = false;
   for (;;) {
     int wait_ms = -1;
     if (limit_s > 0.0) {
       const double left = limit_s - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (left <= 0.0) break;
-      wait_ms = static_cast<int>(std::ceil(left * 1000.0));
+      if (left <= 0.0) {
+        hit_limit = true;
+        break;
+      }
+      wait_ms = static_cast<int>(std::min(std::ceil(left * 1000.0), 3.6e6));  // poll again at most hourly
     }
     pollfd pf{fds[0], POLLIN, 0};
     const int ready = ::poll(&pf, 1, wait_ms);
     if (ready < 0 && errno == EINTR) continue;
-    if (ready <= 0) break;  // timed out (0), or poll failed: the wait below decides
+    if (ready == 0) continue;  // the loop's head decides whether the time is up
+    if (ready < 0) break;      // poll failed: the wait below decides
     const ssize_t n = ::read(fds[0], buf, sizeof buf);
     if (n > 0) r.output.append(buf, static_cast<std::size_t>(n));
     else if (n < 0 && errno == EINTR) continue;
     else break;
   }
-  ::close(fds[0]);
-  Reaped end;
-  end.pid = ::wait4(pid, &end.wait_status, limit_s > 0.0 ? WNOHANG : 0, &end.usage);
-  while (end.pid < 0 && errno == EINTR) end.pid = ::wait4(pid, &end.wait_status, limit_s > 0.0 ? WNOHANG : 0, &end.usage);
-  if (end.pid < 0) throw ComputeError(fmt::format("waiting for {} failed: {}", argv_s[0], std::strerror(errno)));
-  if (end.pid == 0) {
-    // Still running at its limit, or it closed its output and goes on: a short wait, then it is ended.
-    const ChildEnd e = wait_with_limit(pid, start, limit_s, grace_s);
-    r.end = e;
+  if (hit_limit) {
+    // Ended with its family while the pipe is still open (a command writing into a closed
+    // pipe would die of SIGPIPE instead, and read as a failure rather than a timeout).
+    // A command that had already exited (a descendant of its held the pipe) keeps its own
+    // status; its group goes all the same.
+    siginfo_t info{};
+    const bool exited = ::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == pid;
+    const std::vector<Reaped> ended = stop_and_reap({pid}, grace_s);
+    ::close(fds[0]);
+    if (!ended.empty()) r.end = child_end(ended.front().wait_status, ended.front().usage, 0.0);
+    else r.end.signal = SIGKILL;  // not reaped: stuck after SIGKILL (stop_and_reap warned)
+    r.end.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.end.timed_out = !exited;
     return r;
   }
-  r.end = child_end(end.wait_status, end.usage, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  ::close(fds[0]);
+  // The command closed its output: it has ended or is about to (or it goes on without
+  // output, then for the rest of its limit).
+  if (limit_s > 0.0) {
+    r.end = wait_with_limit(pid, start, limit_s, grace_s);
+    return r;
+  }
+  int status = 0;
+  rusage ru{};
+  while (::wait4(pid, &status, 0, &ru) < 0)
+    if (errno != EINTR) throw ComputeError(fmt::format("waiting for {} failed: {}", argv_s[0], std::strerror(errno)));
+  r.end = child_end(status, ru, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return r;
 }
 

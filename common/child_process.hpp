@@ -102,9 +102,10 @@ struct Reaped {
 std::optional<Reaped> poll_any();
 
 /// Waits for `pid` (started at `start`). After `limit_s` seconds of wall clock
-/// the child's group and descendants get SIGTERM, SIGKILL `grace_s` later; the
-/// run then counts as timed out whatever its status. Descendants left behind
-/// by a timed-out child are killed too.
+/// the child's group and descendants are ended by stop_and_reap (SIGTERM,
+/// SIGKILL `grace_s` later, descendants left behind by a child that ended on
+/// SIGTERM included); the run then counts as timed out whatever its status. A
+/// timed-out child stuck after SIGKILL reads as killed by SIGKILL, unreaped.
 ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start, double limit_s, double grace_s = 2.0);
 
 /// Runs `read` on `file` in a child first (its output discarded, its exceptions
@@ -131,9 +132,10 @@ CapturedRun run_captured(const std::vector<std::string>& argv, const ChildSetup&
 /// limit): SIGTERM to each child's process group and every descendant (in
 /// whatever group), SIGKILL to those still running `grace_s` later (a stage stuck
 /// in a library that ignores SIGTERM); returns once every child is reaped and
-/// every descendant has ended, with each reaped child's status. Processes that
-/// outlast their SIGKILL by `stuck_s` (uninterruptible sleep on a hung file
-/// system) are named in a warning and left: a child among them has no entry.
+/// every descendant has ended or been sent SIGKILL, with each reaped child's
+/// status. Children that outlast their SIGKILL by `stuck_s` (uninterruptible
+/// sleep on a hung file system) are named in a warning with the descendants
+/// still running, and left: they have no entry.
 std::vector<Reaped> stop_and_reap(const std::vector<pid_t>& pids, double grace_s = 30.0, double stuck_s = 10.0);
 
 /// Sends `sig` to the child's process group and to every live descendant.
