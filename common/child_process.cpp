@@ -148,6 +148,20 @@ pid_t spawn_exec(const std::vector<std::string>& argv_s, const ChildSetup& setup
   return spawn_with_output([&a]() -> int { return exec_body(a); }, without_env, -1);
 }
 
+namespace {
+// A child past its time limit (started at `start`) ended with its group and descendants
+// (stop_and_reap): its end, timed out. One stuck after SIGKILL reads as killed by it, unreaped.
+ChildEnd stop_at_limit(pid_t pid, std::chrono::steady_clock::time_point start, double grace_s) {
+  const std::vector<Reaped> ended = stop_and_reap({pid}, grace_s);
+  ChildEnd e;
+  if (!ended.empty()) e = child_end(ended.front().wait_status, ended.front().usage, 0.0);
+  else e.signal = SIGKILL;  // stop_and_reap warned
+  e.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  e.timed_out = true;
+  return e;
+}
+}  // namespace
+
 CapturedRun run_captured(const std::vector<std::string>& argv_s, const ChildSetup& setup, double limit_s, double grace_s) {
   if (argv_s.empty()) throw ComputeError("cannot start a child process: empty command");
   int fds[2];
@@ -197,11 +211,8 @@ CapturedRun run_captured(const std::vector<std::string>& argv_s, const ChildSetu
     // status; its group goes all the same.
     siginfo_t info{};
     const bool exited = ::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == pid;
-    const std::vector<Reaped> ended = stop_and_reap({pid}, grace_s);
+    r.end = stop_at_limit(pid, start, grace_s);
     ::close(fds[0]);
-    if (!ended.empty()) r.end = child_end(ended.front().wait_status, ended.front().usage, 0.0);
-    else r.end.signal = SIGKILL;  // not reaped: stuck after SIGKILL (stop_and_reap warned)
-    r.end.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     r.end.timed_out = !exited;
     return r;
   }
@@ -358,14 +369,7 @@ ChildEnd wait_with_limit(pid_t pid, std::chrono::steady_clock::time_point start,
     if (r.pid < 0 && errno != EINTR) throw ComputeError(fmt::format("waiting for process {} failed: {}", pid, std::strerror(errno)));
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (elapsed > limit_s) {
-      // Timed out: the child, its group and its descendants (a stage it started) end.
-      const std::vector<Reaped> ended = stop_and_reap({pid}, grace_s);
-      ChildEnd e;
-      if (!ended.empty()) e = child_end(ended.front().wait_status, ended.front().usage, 0.0);
-      else e.signal = SIGKILL;  // not reaped: stuck after SIGKILL (stop_and_reap warned)
-      e.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      e.timed_out = true;
-      return e;
+      return stop_at_limit(pid, start, grace_s);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(elapsed < 1 ? 5 : 50));
   }
