@@ -4,12 +4,15 @@
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdlib>
+#include <exception>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "common/error.hpp"
 
@@ -58,6 +61,60 @@ void parallel_ranges(std::size_t n, std::size_t grain, const std::function<void(
   arena->execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::max<std::size_t>(1, grain)),
                       [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+  });
+}
+
+int ordered_slots() { return threads_now > 1 && arena ? 2 * threads_now : 1; }
+
+void parallel_ordered(std::size_t n, std::size_t grain, const std::function<void(std::size_t, std::size_t, int)>& compute,
+                      const std::function<void(std::size_t, std::size_t, int)>& consume) {
+  grain = std::max<std::size_t>(1, grain);
+  const std::size_t chunks = (n + grain - 1) / grain;
+  const int slots = ordered_slots();
+  if (slots == 1 || chunks <= 1) {
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::size_t begin = c * grain, end = std::min(n, begin + grain);
+      compute(begin, end, 0);
+      consume(begin, end, 0);
+    }
+    return;
+  }
+  // A pipeline of `slots` tokens: chunks are taken in order, computed in parallel and
+  // consumed in order. Chunk c + slots is taken only once a token is free, and tokens
+  // come free in chunk order (the last stage is in order), so chunk c has been consumed
+  // by then: slot c % slots is never shared by two chunks in flight.
+  std::vector<std::exception_ptr> failed(static_cast<std::size_t>(slots));
+  std::size_t next = 0;
+  auto range = [&](std::size_t c) { return std::pair{c * grain, std::min(n, c * grain + grain)}; };
+  arena->execute([&] {
+    tbb::parallel_pipeline(
+        static_cast<std::size_t>(slots),
+        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                            [&](tbb::flow_control& fc) -> std::size_t {
+                                              if (next == chunks) {
+                                                fc.stop();
+                                                return 0;
+                                              }
+                                              return next++;
+                                            }) &
+            tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel,
+                                                       [&](std::size_t c) {
+                                                         const int s = static_cast<int>(c % static_cast<std::size_t>(slots));
+                                                         const auto [begin, end] = range(c);
+                                                         failed[static_cast<std::size_t>(s)] = nullptr;
+                                                         try {
+                                                           compute(begin, end, s);
+                                                         } catch (...) {
+                                                           failed[static_cast<std::size_t>(s)] = std::current_exception();
+                                                         }
+                                                         return c;
+                                                       }) &
+            tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, [&](std::size_t c) {
+              const int s = static_cast<int>(c % static_cast<std::size_t>(slots));
+              if (failed[static_cast<std::size_t>(s)]) std::rethrow_exception(failed[static_cast<std::size_t>(s)]);
+              const auto [begin, end] = range(c);
+              consume(begin, end, s);
+            }));
   });
 }
 

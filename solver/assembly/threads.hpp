@@ -38,4 +38,20 @@ class AssemblyThreads {
 /// is rethrown here once every chunk has stopped.
 void parallel_ranges(std::size_t n, std::size_t grain, const std::function<void(std::size_t, std::size_t)>& body);
 
+/// How many buffers a parallel_ordered loop started now may fill at once (>= 1).
+int ordered_slots();
+
+/// An element loop whose blocks reach the assembler in serial order while their
+/// work runs in parallel: over chunks of [0, n) of `grain` items, compute(begin,
+/// end, slot) on assembly_threads() threads, and consume(begin, end, slot) for
+/// each chunk, one chunk at a time and in chunk order, after its compute. So
+/// every sum the consumer makes is the one-thread loop's, bit for bit, with no
+/// colouring: for terms whose blocks move with the state (contact) or whose
+/// scatter is a small share. `slot` < ordered_slots() names the buffer a chunk's
+/// compute fills and its consume reads: no two chunks in flight share one. A
+/// compute that throws stops the loop at its chunk's turn, so the exception
+/// rethrown here is the first in chunk order, as in the serial loop.
+void parallel_ordered(std::size_t n, std::size_t grain, const std::function<void(std::size_t, std::size_t, int)>& compute,
+                      const std::function<void(std::size_t, std::size_t, int)>& consume);
+
 }  // namespace stentsim::solver

@@ -1,4 +1,8 @@
 #include "solver/beams/beam_term.hpp"
+
+#include <type_traits>
+
+#include "solver/assembly/threads.hpp"
 #include "solver/beams/rigid_joints.hpp"
 
 #include "common/error.hpp"
@@ -118,34 +122,54 @@ void BeamTerm::gather(const Eigen::VectorXd& u, std::size_t e, std::array<Eigen:
   }
 }
 
+namespace {
+
+// Beam elements per chunk of the threaded loop: a stent has thousands, each a
+// few microseconds of work.
+constexpr std::size_t kBeamChunk = 64;
+
+}  // namespace
+
 void BeamTerm::assemble(const SystemState& state, Assembler& out) {
   const std::size_t ne = body_.elements.size();
-  std::array<Eigen::Vector3d, 4> x;
-  std::array<Eigen::Quaterniond, 3> q;
   // MPI: every rank evaluates every element (beam bodies are small) so that
   // each rank holds the whole trial history, and commit() gives every rank
   // the whole committed history (rank 0 writes outputs and checkpoints);
   // only the rank's own elements go to the assembler, which sums over ranks.
   const bool plastic = body_.section.plastic.has_value();
-  for (std::size_t e = 0; e < ne; ++e) {
-    const bool mine = state.owns(e, ne);
-    if (!mine && !plastic) continue;
-    gather(state.u, e, x, q);
-    const std::vector<GlobalDof> d = element_dofs(e);
-    // Plastic sections: return from the committed history; the trial history
-    // of this (latest) state is what commit() keeps.
-    const PlasticBendingHistory* hc = hist_committed_.data() + hist_offset_[e];
-    PlasticBendingHistory* ht = hist_trial_.data() + hist_offset_[e];
-    if (body_.interpolation == BeamInterpolation::hermite3) {
-      ElementSystem<4, 3> s;
-      element_system<4, 3>(refs_[e], body_.section, x, q, s, hc, ht, &work_trial_[e]);
-      if (mine) out.add(d, s.R, s.K);
-    } else {
-      ElementSystem<2, 2> s;
-      element_system<2, 2>(refs_[e], body_.section, x, q, s, hc, ht, &work_trial_[e]);
-      if (mine) out.add(d, s.R, s.K);
-    }
-  }
+  auto needed = [&](std::size_t e) { return plastic || state.owns(e, ne); };
+  // Threads compute elements (the kernel is the cost); their blocks reach the
+  // assembler in element order (threads.hpp), the one-thread sums exactly.
+  // Plastic sections return from the committed history; the trial history of
+  // this (latest) state is what commit() keeps. Each element writes only its own
+  // history slots and plastic work.
+  auto run = [&](auto& slots, auto kernel) {
+    using System = typename std::decay_t<decltype(slots)>::value_type::value_type;
+    slots.resize(static_cast<std::size_t>(ordered_slots()));
+    parallel_ordered(
+        ne, kBeamChunk,
+        [&](std::size_t begin, std::size_t end, int slot) {
+          std::array<Eigen::Vector3d, 4> x;
+          std::array<Eigen::Quaterniond, 3> q;
+          auto& systems = slots[static_cast<std::size_t>(slot)];
+          systems.resize(end - begin);
+          for (std::size_t e = begin; e < end; ++e) {
+            if (!needed(e)) continue;
+            gather(state.u, e, x, q);
+            System& s = systems[e - begin];
+            s = System{};
+            kernel(refs_[e], body_.section, x, q, s, hist_committed_.data() + hist_offset_[e],
+                   hist_trial_.data() + hist_offset_[e], &work_trial_[e]);
+          }
+        },
+        [&](std::size_t begin, std::size_t end, int slot) {
+          const auto& systems = slots[static_cast<std::size_t>(slot)];
+          for (std::size_t e = begin; e < end; ++e)
+            if (state.owns(e, ne)) out.add(element_dofs(e), systems[e - begin].R, systems[e - begin].K);
+        });
+  };
+  if (body_.interpolation == BeamInterpolation::hermite3) run(hermite_slots_, element_system<4, 3>);
+  else run(linear_slots_, element_system<2, 2>);
   assembled_serial_ = state_serial_;
 }
 

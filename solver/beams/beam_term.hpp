@@ -145,6 +145,9 @@ class BeamTerm : public Term {
   std::vector<PlasticBendingHistory> hist_committed_, hist_trial_;
   std::vector<char> yielded_committed_;  // per Gauss point: flowed in the last committed step
   std::vector<double> work_trial_;  // plastic work increment of element e in the last assemble
+  // Element systems a chunk of the threaded loop holds until its turn to scatter, per slot.
+  std::vector<std::vector<ElementSystem<4, 3>>> hermite_slots_;
+  std::vector<std::vector<ElementSystem<2, 2>>> linear_slots_;
   double plastic_work_committed_ = 0.0;
   // Which state the trial history belongs to: trial()/set_rotation() start a
   // new state, accept() marks it accepted, assemble() marks the history as

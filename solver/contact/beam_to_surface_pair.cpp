@@ -9,6 +9,7 @@
 
 #include "common/error.hpp"
 #include "common/log.hpp"
+#include "solver/assembly/threads.hpp"
 #include "solver/contact/owned_flags.hpp"
 #include "solver/terms/element_failure.hpp"
 
@@ -154,6 +155,10 @@ struct PairBlock {
   Eigen::MatrixXd k;
 };
 
+// Beam elements per chunk of the threaded loop (each projects its Gauss points on
+// a few faces and forms blocks of ~60 x 60).
+constexpr std::size_t kContactChunk = 16;
+
 }  // namespace
 
 void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
@@ -163,186 +168,212 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
     refresh_search(state.u);
   }
   const bool tangent = out.wants_tangent();
-  const bool potential = settings_.form == BeamContactForm::potential;
   rank_ = state.rank, ranks_ = state.ranks;
   const std::size_t ne = gauss_.size();
+  // Threads project and integrate beam elements (the cost); their blocks reach the
+  // assembler in element order (threads.hpp), so the sums are the one-thread loop's.
+  // An element writes only its own points' active flags and reserved faces; the
+  // surface's normal derivatives are computed once per update under its lock.
+  chunks_.resize(static_cast<std::size_t>(ordered_slots()));
+  int unconverged = 0;
+  parallel_ordered(
+      ne, kContactChunk,
+      [&](std::size_t begin, std::size_t end, int slot) {
+        Chunk& c = chunks_[static_cast<std::size_t>(slot)];
+        c.used = 0;
+        c.unconverged = 0;
+        for (std::size_t e = begin; e < end; ++e)
+          if (state.owns(e, ne)) element_blocks(state, e, tangent, c);
+      },
+      [&](std::size_t, std::size_t, int slot) {
+        Chunk& c = chunks_[static_cast<std::size_t>(slot)];
+        for (std::size_t k = 0; k < c.used; ++k) out.add(c.blocks[k].dofs, c.blocks[k].r, c.blocks[k].k);
+        unconverged += c.unconverged;
+      });
+  if (tangent) unconverged_ = unconverged;
+}
+
+BeamToSurfacePair::Block& BeamToSurfacePair::Chunk::next() {
+  if (used == blocks.size()) blocks.emplace_back();
+  return blocks[used++];
+}
+
+void BeamToSurfacePair::element_blocks(const SystemState& state, std::size_t e, bool tangent, Chunk& out) {
+  const bool potential = settings_.form == BeamContactForm::potential;
   const int ng = settings_.gauss_points, nq = 3 * nc_;
   GapDerivatives gd;
   NormalFieldDerivatives nd;
   std::vector<PairBlock> blocks;
   std::vector<int> near;  // the faces this element's points project onto within reach
-  int unconverged = 0;
-  for (std::size_t e = 0; e < ne; ++e) {
-    if (!state.owns(e, ne)) continue;
-    const auto x = centerline(state.u, e);
-    blocks.clear();
-    near.clear();
-    for (int q = 0; q < ng; ++q) {
-      const GaussPoint& gp = gauss_[e][static_cast<std::size_t>(q)];
-      const std::size_t id = e * static_cast<std::size_t>(ng) + static_cast<std::size_t>(q);
-      Vec3 p = Vec3::Zero();
-      for (int k = 0; k < nc_; ++k) p += gp.B[static_cast<std::size_t>(k)] * x[static_cast<std::size_t>(k)];
-      int face = -1;
-      Reach where = Reach::nowhere;
-      const NormalProjection pr =
-          project(*surface_, candidates_[e].faces, p, face, where, tangent ? &unconverged : nullptr, &face_boxes_);
-      // A point in contact in the last converged state that now projects nowhere, or far through the
-      // surface, would silently lose its force: a failed iteration instead (the step is cut).
-      if (active_.committed(id) && (where == Reach::nowhere || where == Reach::deep))
-        throw ElementFailure(fmt::format("contact '{}': Gauss point {} of beam element {} at ({:.4g}, {:.4g}, {:.4g}) was in "
-                                         "contact in the last converged state but {} now",
-                                         name_, q, e, p.x(), p.y(), p.z(),
-                                         where == Reach::deep ? fmt::format("lies more than the search reach inside '{}'", surface_->name())
-                                                              : fmt::format("projects onto no face of '{}'", surface_->name())));
-      if (face >= 0) near.push_back(face);
-      const bool active = face >= 0 && pr.distance - settings_.radius < settings_.law.active_limit();
-      // The active set of Newton iterates (tangent assemblies), not of line-search trials.
-      if (tangent) {
-        const int changes = active_.evaluate(id, active);
-        if (changes > settings_.max_flips)
-          throw ElementFailure(fmt::format("contact '{}': Gauss point {} of beam element {} switched in and out of contact {} "
-                                           "times in this step (active-set chattering; max_flips = {})", name_, q, e, changes,
-                                           settings_.max_flips));
-      }
-      if (!active) continue;
-      double phi, d1, d2;
-      settings_.law.eval(pr.distance - settings_.radius, phi, d1, d2);
-      const int nf = surface_->faces()[static_cast<std::size_t>(face)].count;
-      auto it = std::find_if(blocks.begin(), blocks.end(), [&](const PairBlock& b) { return b.face == face; });
-      if (it == blocks.end()) {
-        const int n = nq + 6 * nf;
-        blocks.push_back({face, Eigen::VectorXd::Zero(n), tangent ? Eigen::MatrixXd::Zero(n, n) : Eigen::MatrixXd()});
-        it = blocks.end() - 1;
-      }
-      // v = (p, x_k, n_k) -> v' = (q, x_k, n_k) with p = Σ B_j q_j.
-      const double w = gp.weight;
-      const int nr = 6 * nf;
-      if (settings_.form == BeamContactForm::gap_variation) {
-        normal_field_derivatives(*surface_, face, pr, tangent, nd);
-        for (int j = 0; j < nc_; ++j) it->g.segment<3>(3 * j) += w * d1 * gp.B[static_cast<std::size_t>(j)] * nd.normal;
-        for (int k = 0; k < nf; ++k) it->g.segment<3>(nq + 3 * k) -= w * d1 * nd.n[static_cast<std::size_t>(k)] * nd.normal;
-        if (!tangent) continue;
-        // Rows (beam vectors q_j, face nodes x_k) against columns v = (p, x_k, n_k).
-        const int N = 3 + nr;
-        Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(nq + 3 * nf, N);
-        const Eigen::MatrixXd beam_row = d2 * nd.normal * nd.gap_grad.transpose() + d1 * nd.dnormal;
-        for (int j = 0; j < nc_; ++j) rows.middleRows<3>(3 * j) = w * gp.B[static_cast<std::size_t>(j)] * beam_row;
-        for (int k = 0; k < nf; ++k) {
-          const double nk = nd.n[static_cast<std::size_t>(k)];
-          rows.middleRows<3>(nq + 3 * k) = -w * (nk * beam_row + d1 * nd.normal * nd.dshape.row(k));
-        }
-        // Columns: p -> q_b (× B_b); x_k, n_k as they are.
-        for (int b = 0; b < nc_; ++b)
-          it->k.block(0, 3 * b, nq + 3 * nf, 3) += gp.B[static_cast<std::size_t>(b)] * rows.leftCols<3>();
-        it->k.block(0, nq, nq + 3 * nf, nr) += rows.rightCols(nr);
-        continue;
-      }
-      gap_derivatives(*surface_, face, pr, tangent, gd);
-      for (int j = 0; j < nc_; ++j) it->g.segment<3>(3 * j) += w * d1 * gp.B[static_cast<std::size_t>(j)] * gd.grad.head<3>();
-      it->g.segment(nq, nr) += w * d1 * gd.grad.tail(nr);
-      if (!tangent) continue;
-      const Eigen::MatrixXd h = w * (d2 * gd.grad * gd.grad.transpose() + d1 * gd.hess);
-      for (int a = 0; a < nc_; ++a) {
-        const double ba = gp.B[static_cast<std::size_t>(a)];
-        for (int b = 0; b < nc_; ++b) it->k.block<3, 3>(3 * a, 3 * b) += ba * gp.B[static_cast<std::size_t>(b)] * h.block<3, 3>(0, 0);
-        it->k.block(3 * a, nq, 3, nr) += ba * h.block(0, 3, 3, nr);
-        it->k.block(nq, 3 * a, nr, 3) += ba * h.block(3, 0, nr, 3);
-      }
-      it->k.block(nq, nq, nr, nr) += h.block(3, 3, nr, nr);
-    }
-    // Scatter each pair through T = ∂v'/∂(DOFs); reserve the pattern of candidate pairs with no active point.
-    const std::vector<GlobalDof> beam_dofs = beam_.element_dofs(e);
-    auto patch_of = [&](int face, std::vector<int>& patch) {
-      const SurfaceFace& f = surface_->faces()[static_cast<std::size_t>(face)];
-      patch.clear();
-      for (int k = 0; k < f.count; ++k) {
-        const auto& nd = surface_->normal_derivatives(f.node[k], potential);
-        patch.insert(patch.end(), nd.patch.begin(), nd.patch.end());
-      }
-      std::sort(patch.begin(), patch.end());
-      patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
-    };
-    auto dofs_of = [&](const std::vector<int>& patch) {
-      std::vector<GlobalDof> d(beam_dofs.begin(), beam_dofs.begin() + nq);
-      for (int n : patch)
-        for (int c = 0; c < 3; ++c) d.push_back(surface_->dof(n, c));
-      return d;
-    };
-    std::vector<int> patch;
-    for (const PairBlock& b : blocks) {
-      const SurfaceFace& f = surface_->faces()[static_cast<std::size_t>(b.face)];
-      patch_of(b.face, patch);
-      auto slot = [&](int n) { return nq + 3 * static_cast<int>(std::lower_bound(patch.begin(), patch.end(), n) - patch.begin()); };
-      const int M = nq + 3 * static_cast<int>(patch.size()), nv = nq + 6 * f.count;
-      // T = ∂v'/∂(DOFs) by its 3 x 3 blocks, never formed: per triple t of v' the (column slot,
-      // block) pairs — identity for the beam vectors and the face nodes, the nodal normals'
-      // Jacobian blocks over their patches. Applied to columns (K' T) and to rows (Tᵀ ·).
-      std::vector<std::vector<std::pair<int, Mat3>>> map(static_cast<std::size_t>(nv / 3));
-      for (int t = 0; t < nq / 3; ++t) map[static_cast<std::size_t>(t)].emplace_back(3 * t, Mat3::Identity());
-      for (int k = 0; k < f.count; ++k) {
-        map[static_cast<std::size_t>(nq / 3 + k)].emplace_back(slot(f.node[k]), Mat3::Identity());
-        const NormalDerivatives& nd = surface_->normal_derivatives(f.node[k], potential);
-        auto& nk = map[static_cast<std::size_t>(nq / 3 + f.count + k)];
-        for (std::size_t m = 0; m < nd.patch.size(); ++m)
-          nk.emplace_back(slot(nd.patch[m]), nd.jacobian.block<3, 3>(0, 3 * static_cast<int>(m)));
-      }
-      // Gap variation: no residual on the normals (their rows of g' and K' are zero).
-      const int row_triples = potential ? nv / 3 : nq / 3 + f.count;
-      Eigen::VectorXd r = Eigen::VectorXd::Zero(M);
-      for (int t = 0; t < row_triples; ++t)
-        for (const auto& [col, J] : map[static_cast<std::size_t>(t)]) r.segment<3>(col) += J.transpose() * b.g.segment<3>(3 * t);
-      Eigen::MatrixXd K;
-      if (tangent) {
-        Eigen::MatrixXd KT = Eigen::MatrixXd::Zero(3 * row_triples, M);
-        for (int t = 0; t < nv / 3; ++t)
-          for (const auto& [col, J] : map[static_cast<std::size_t>(t)])
-            KT.middleCols<3>(col) += b.k.block(0, 3 * t, 3 * row_triples, 3) * J;
-        K = Eigen::MatrixXd::Zero(M, M);
-        for (int t = 0; t < row_triples; ++t)
-          for (const auto& [row, J] : map[static_cast<std::size_t>(t)]) K.middleRows<3>(row) += J.transpose() * KT.middleRows<3>(3 * t);
-        for (int k = 0; k < f.count && potential; ++k) {
-          const NormalDerivatives& nd = surface_->normal_derivatives(f.node[k], true);
-          std::vector<int> s(nd.patch.size());
-          for (std::size_t m = 0; m < nd.patch.size(); ++m) s[m] = slot(nd.patch[m]);
-          for (int c = 0; c < 3; ++c) {
-            const double gc = b.g[nq + 3 * f.count + 3 * k + c];
-            if (gc == 0.0) continue;
-            for (std::size_t i = 0; i < s.size(); ++i)
-              for (std::size_t j = 0; j < s.size(); ++j)
-                K.block<3, 3>(s[i], s[j]) += gc * nd.hessian[c].block<3, 3>(3 * static_cast<int>(i), 3 * static_cast<int>(j));
-          }
-        }
-      }
-      const std::vector<GlobalDof> dofs = dofs_of(patch);
-      out.add(dofs, r, K);
-    }
+  const auto x = centerline(state.u, e);
+  for (int q = 0; q < ng; ++q) {
+    const GaussPoint& gp = gauss_[e][static_cast<std::size_t>(q)];
+    const std::size_t id = e * static_cast<std::size_t>(ng) + static_cast<std::size_t>(q);
+    Vec3 p = Vec3::Zero();
+    for (int k = 0; k < nc_; ++k) p += gp.B[static_cast<std::size_t>(k)] * x[static_cast<std::size_t>(k)];
+    int face = -1;
+    Reach where = Reach::nowhere;
+    const NormalProjection pr =
+        project(*surface_, candidates_[e].faces, p, face, where, tangent ? &out.unconverged : nullptr, &face_boxes_);
+    // A point in contact in the last converged state that now projects nowhere, or far through the
+    // surface, would silently lose its force: a failed iteration instead (the step is cut).
+    if (active_.committed(id) && (where == Reach::nowhere || where == Reach::deep))
+      throw ElementFailure(fmt::format("contact '{}': Gauss point {} of beam element {} at ({:.4g}, {:.4g}, {:.4g}) was in "
+                                       "contact in the last converged state but {} now",
+                                       name_, q, e, p.x(), p.y(), p.z(),
+                                       where == Reach::deep ? fmt::format("lies more than the search reach inside '{}'", surface_->name())
+                                                            : fmt::format("projects onto no face of '{}'", surface_->name())));
+    if (face >= 0) near.push_back(face);
+    const bool active = face >= 0 && pr.distance - settings_.radius < settings_.law.active_limit();
+    // The active set of Newton iterates (tangent assemblies), not of line-search trials.
     if (tangent) {
-      // Reserve the pattern of the faces a point is near but not yet pressed on, so that its
-      // contact usually starts inside the pattern the solver has analysed. Only these: all the
-      // search's candidate faces (every face within the margin of the element's box) made the
-      // matrix 40 % larger and its LU fill 25 % (free expansion: 1.45 M against 1.04 M entries).
-      // The global pattern only grows, so a pair reserved once keeps its entries.
-      std::vector<int>& done = reserved_[e];
-      std::sort(near.begin(), near.end());
-      near.erase(std::unique(near.begin(), near.end()), near.end());
-      bool added = false;
-      for (int face : near) {
-        if (std::binary_search(done.begin(), done.end(), face)) continue;
-        added = true;
-        if (std::any_of(blocks.begin(), blocks.end(), [&](const PairBlock& b) { return b.face == face; })) continue;
-        patch_of(face, patch);
-        const std::vector<GlobalDof> dofs = dofs_of(patch);
-        const auto n = static_cast<Eigen::Index>(dofs.size());
-        out.add(dofs, Eigen::VectorXd::Zero(n), Eigen::MatrixXd::Zero(n, n));
+      const int changes = active_.evaluate(id, active);
+      if (changes > settings_.max_flips)
+        throw ElementFailure(fmt::format("contact '{}': Gauss point {} of beam element {} switched in and out of contact {} "
+                                         "times in this step (active-set chattering; max_flips = {})", name_, q, e, changes,
+                                         settings_.max_flips));
+    }
+    if (!active) continue;
+    double phi, d1, d2;
+    settings_.law.eval(pr.distance - settings_.radius, phi, d1, d2);
+    const int nf = surface_->faces()[static_cast<std::size_t>(face)].count;
+    auto it = std::find_if(blocks.begin(), blocks.end(), [&](const PairBlock& b) { return b.face == face; });
+    if (it == blocks.end()) {
+      const int n = nq + 6 * nf;
+      blocks.push_back({face, Eigen::VectorXd::Zero(n), tangent ? Eigen::MatrixXd::Zero(n, n) : Eigen::MatrixXd()});
+      it = blocks.end() - 1;
+    }
+    // v = (p, x_k, n_k) -> v' = (q, x_k, n_k) with p = Σ B_j q_j.
+    const double w = gp.weight;
+    const int nr = 6 * nf;
+    if (settings_.form == BeamContactForm::gap_variation) {
+      normal_field_derivatives(*surface_, face, pr, tangent, nd);
+      for (int j = 0; j < nc_; ++j) it->g.segment<3>(3 * j) += w * d1 * gp.B[static_cast<std::size_t>(j)] * nd.normal;
+      for (int k = 0; k < nf; ++k) it->g.segment<3>(nq + 3 * k) -= w * d1 * nd.n[static_cast<std::size_t>(k)] * nd.normal;
+      if (!tangent) continue;
+      // Rows (beam vectors q_j, face nodes x_k) against columns v = (p, x_k, n_k).
+      const int N = 3 + nr;
+      Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(nq + 3 * nf, N);
+      const Eigen::MatrixXd beam_row = d2 * nd.normal * nd.gap_grad.transpose() + d1 * nd.dnormal;
+      for (int j = 0; j < nc_; ++j) rows.middleRows<3>(3 * j) = w * gp.B[static_cast<std::size_t>(j)] * beam_row;
+      for (int k = 0; k < nf; ++k) {
+        const double nk = nd.n[static_cast<std::size_t>(k)];
+        rows.middleRows<3>(nq + 3 * k) = -w * (nk * beam_row + d1 * nd.normal * nd.dshape.row(k));
       }
-      if (added) {
-        std::vector<int> merged;
-        std::set_union(done.begin(), done.end(), near.begin(), near.end(), std::back_inserter(merged));
-        done.swap(merged);
+      // Columns: p -> q_b (× B_b); x_k, n_k as they are.
+      for (int b = 0; b < nc_; ++b)
+        it->k.block(0, 3 * b, nq + 3 * nf, 3) += gp.B[static_cast<std::size_t>(b)] * rows.leftCols<3>();
+      it->k.block(0, nq, nq + 3 * nf, nr) += rows.rightCols(nr);
+      continue;
+    }
+    gap_derivatives(*surface_, face, pr, tangent, gd);
+    for (int j = 0; j < nc_; ++j) it->g.segment<3>(3 * j) += w * d1 * gp.B[static_cast<std::size_t>(j)] * gd.grad.head<3>();
+    it->g.segment(nq, nr) += w * d1 * gd.grad.tail(nr);
+    if (!tangent) continue;
+    const Eigen::MatrixXd h = w * (d2 * gd.grad * gd.grad.transpose() + d1 * gd.hess);
+    for (int a = 0; a < nc_; ++a) {
+      const double ba = gp.B[static_cast<std::size_t>(a)];
+      for (int b = 0; b < nc_; ++b) it->k.block<3, 3>(3 * a, 3 * b) += ba * gp.B[static_cast<std::size_t>(b)] * h.block<3, 3>(0, 0);
+      it->k.block(3 * a, nq, 3, nr) += ba * h.block(0, 3, 3, nr);
+      it->k.block(nq, 3 * a, nr, 3) += ba * h.block(3, 0, nr, 3);
+    }
+    it->k.block(nq, nq, nr, nr) += h.block(3, 3, nr, nr);
+  }
+  // Scatter each pair through T = ∂v'/∂(DOFs); reserve the pattern of candidate pairs with no active point.
+  const std::vector<GlobalDof> beam_dofs = beam_.element_dofs(e);
+  auto patch_of = [&](int face, std::vector<int>& patch) {
+    const SurfaceFace& f = surface_->faces()[static_cast<std::size_t>(face)];
+    patch.clear();
+    for (int k = 0; k < f.count; ++k) {
+      const auto& nd = surface_->normal_derivatives(f.node[k], potential);
+      patch.insert(patch.end(), nd.patch.begin(), nd.patch.end());
+    }
+    std::sort(patch.begin(), patch.end());
+    patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+  };
+  auto dofs_of = [&](const std::vector<int>& patch) {
+    std::vector<GlobalDof> d(beam_dofs.begin(), beam_dofs.begin() + nq);
+    for (int n : patch)
+      for (int c = 0; c < 3; ++c) d.push_back(surface_->dof(n, c));
+    return d;
+  };
+  std::vector<int> patch;
+  for (const PairBlock& b : blocks) {
+    const SurfaceFace& f = surface_->faces()[static_cast<std::size_t>(b.face)];
+    patch_of(b.face, patch);
+    auto slot = [&](int n) { return nq + 3 * static_cast<int>(std::lower_bound(patch.begin(), patch.end(), n) - patch.begin()); };
+    const int M = nq + 3 * static_cast<int>(patch.size()), nv = nq + 6 * f.count;
+    // T = ∂v'/∂(DOFs) by its 3 x 3 blocks, never formed: per triple t of v' the (column slot,
+    // block) pairs — identity for the beam vectors and the face nodes, the nodal normals'
+    // Jacobian blocks over their patches. Applied to columns (K' T) and to rows (Tᵀ ·).
+    std::vector<std::vector<std::pair<int, Mat3>>> map(static_cast<std::size_t>(nv / 3));
+    for (int t = 0; t < nq / 3; ++t) map[static_cast<std::size_t>(t)].emplace_back(3 * t, Mat3::Identity());
+    for (int k = 0; k < f.count; ++k) {
+      map[static_cast<std::size_t>(nq / 3 + k)].emplace_back(slot(f.node[k]), Mat3::Identity());
+      const NormalDerivatives& nd = surface_->normal_derivatives(f.node[k], potential);
+      auto& nk = map[static_cast<std::size_t>(nq / 3 + f.count + k)];
+      for (std::size_t m = 0; m < nd.patch.size(); ++m)
+        nk.emplace_back(slot(nd.patch[m]), nd.jacobian.block<3, 3>(0, 3 * static_cast<int>(m)));
+    }
+    // Gap variation: no residual on the normals (their rows of g' and K' are zero).
+    const int row_triples = potential ? nv / 3 : nq / 3 + f.count;
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(M);
+    for (int t = 0; t < row_triples; ++t)
+      for (const auto& [col, J] : map[static_cast<std::size_t>(t)]) r.segment<3>(col) += J.transpose() * b.g.segment<3>(3 * t);
+    Eigen::MatrixXd K;
+    if (tangent) {
+      Eigen::MatrixXd KT = Eigen::MatrixXd::Zero(3 * row_triples, M);
+      for (int t = 0; t < nv / 3; ++t)
+        for (const auto& [col, J] : map[static_cast<std::size_t>(t)])
+          KT.middleCols<3>(col) += b.k.block(0, 3 * t, 3 * row_triples, 3) * J;
+      K = Eigen::MatrixXd::Zero(M, M);
+      for (int t = 0; t < row_triples; ++t)
+        for (const auto& [row, J] : map[static_cast<std::size_t>(t)]) K.middleRows<3>(row) += J.transpose() * KT.middleRows<3>(3 * t);
+      for (int k = 0; k < f.count && potential; ++k) {
+        const NormalDerivatives& nd = surface_->normal_derivatives(f.node[k], true);
+        std::vector<int> s(nd.patch.size());
+        for (std::size_t m = 0; m < nd.patch.size(); ++m) s[m] = slot(nd.patch[m]);
+        for (int c = 0; c < 3; ++c) {
+          const double gc = b.g[nq + 3 * f.count + 3 * k + c];
+          if (gc == 0.0) continue;
+          for (std::size_t i = 0; i < s.size(); ++i)
+            for (std::size_t j = 0; j < s.size(); ++j)
+              K.block<3, 3>(s[i], s[j]) += gc * nd.hessian[c].block<3, 3>(3 * static_cast<int>(i), 3 * static_cast<int>(j));
+        }
       }
+    }
+    Block& blk = out.next();
+    blk.dofs = dofs_of(patch);
+    blk.r = std::move(r);
+    blk.k = std::move(K);
+  }
+  if (tangent) {
+    // Reserve the pattern of the faces a point is near but not yet pressed on, so that its
+    // contact usually starts inside the pattern the solver has analysed. Only these: all the
+    // search's candidate faces (every face within the margin of the element's box) made the
+    // matrix 40 % larger and its LU fill 25 % (free expansion: 1.45 M against 1.04 M entries).
+    // The global pattern only grows, so a pair reserved once keeps its entries.
+    std::vector<int>& done = reserved_[e];
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    bool added = false;
+    for (int face : near) {
+      if (std::binary_search(done.begin(), done.end(), face)) continue;
+      added = true;
+      if (std::any_of(blocks.begin(), blocks.end(), [&](const PairBlock& b) { return b.face == face; })) continue;
+      patch_of(face, patch);
+      Block& blk = out.next();
+      blk.dofs = dofs_of(patch);
+      const auto n = static_cast<Eigen::Index>(blk.dofs.size());
+      blk.r.setZero(n);
+      blk.k.setZero(n, n);
+    }
+    if (added) {
+      std::vector<int> merged;
+      std::set_union(done.begin(), done.end(), near.begin(), near.end(), std::back_inserter(merged));
+      done.swap(merged);
     }
   }
-  if (tangent) unconverged_ = unconverged;
 }
 
 std::vector<BeamContactPoint> BeamToSurfacePair::evaluate(const Eigen::VectorXd& u) const {

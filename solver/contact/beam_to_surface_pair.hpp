@@ -125,6 +125,22 @@ class BeamToSurfacePair : public Term {
   NormalProjection project(const ContactSurface& surface, const std::vector<int>& faces, const Vec3& p, int& face, Reach& reach,
                            int* unconverged = nullptr, const std::vector<Eigen::AlignedBox3d>* boxes = nullptr) const;
   bool moved_too_far(const Eigen::VectorXd& u) const;
+  // What beam elements add, kept by a chunk of the threaded loop until its turn to
+  // scatter: blocks in the order the serial loop adds them, reused across assemblies.
+  struct Block {
+    std::vector<GlobalDof> dofs;
+    Eigen::VectorXd r;
+    Eigen::MatrixXd k;
+  };
+  struct Chunk {
+    std::vector<Block> blocks;
+    std::size_t used = 0;
+    int unconverged = 0;
+    Block& next();
+  };
+  /// Element e's blocks (pairs with active points, then reserved patterns) into `out`.
+  void element_blocks(const SystemState& state, std::size_t e, bool tangent, Chunk& out);
+  std::vector<Chunk> chunks_;  // per slot of the threaded loop
   /// Search at u and remember the positions it was made at.
   void refresh_search(const Eigen::VectorXd& u);
 

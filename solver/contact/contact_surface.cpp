@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 #include <map>
 
@@ -100,9 +101,26 @@ void ContactSurface::update(const Eigen::VectorXd& u) {
 
 const NormalDerivatives& ContactSurface::normal_derivatives(int local, bool hessians) const {
   const std::size_t i = static_cast<std::size_t>(local);
-  NormalDerivatives& d = dn_[i];
-  // dn_valid_: 0 nothing, 1 the Jacobian, 2 the Jacobian and the Hessians.
-  if (dn_valid_[i] >= (hessians ? 2 : 1)) return d;
+  // dn_valid_: 0 nothing, 1 the Jacobian, 2 the Jacobian and the Hessians. Threads of one
+  // element loop may ask for the same node: the first computes under the node's lock, the
+  // others see its flag. Adding the Hessians later leaves the patch and the Jacobian that
+  // other threads may be reading untouched.
+  const char need = hessians ? 2 : 1;
+  std::atomic_ref<char> valid(dn_valid_[i]);
+  if (valid.load(std::memory_order_acquire) >= need) return dn_[i];
+  const std::lock_guard<std::mutex> lock(locks_.of(i));
+  const char have = valid.load(std::memory_order_relaxed);
+  if (have >= need) return dn_[i];
+  NormalDerivatives t;
+  compute_normal_derivatives(local, hessians, t);
+  if (have == 0) dn_[i] = std::move(t);
+  else dn_[i].hessian = std::move(t.hessian);
+  valid.store(need, std::memory_order_release);
+  return dn_[i];
+}
+
+void ContactSurface::compute_normal_derivatives(int local, bool hessians, NormalDerivatives& d) const {
+  const std::size_t i = static_cast<std::size_t>(local);
   d.patch.clear();
   for (int fi : node_faces_[i]) {
     const SurfaceFace& f = faces_[static_cast<std::size_t>(fi)];
@@ -145,8 +163,7 @@ const NormalDerivatives& ContactSurface::normal_derivatives(int local, bool hess
   const Vec3 n = a / rho;
   const Mat3 P = Mat3::Identity() - n * n.transpose();
   d.jacobian = P / rho * ja;
-  dn_valid_[i] = 1;
-  if (!hessians) return d;
+  if (!hessians) return;
   for (int c = 0; c < 3; ++c) {
     Mat3 hn;
     for (int p = 0; p < 3; ++p)
@@ -155,8 +172,6 @@ const NormalDerivatives& ContactSurface::normal_derivatives(int local, bool hess
     for (int b = 0; b < 3; ++b)
       if (P(c, b) != 0.0) d.hessian[c] += (P(c, b) / rho) * ha[b];
   }
-  dn_valid_[i] = 2;
-  return d;
 }
 
 double ContactSurface::min_edge_length() const {

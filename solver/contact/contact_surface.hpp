@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,7 @@ class ContactSurface {
   const Vec3& normal(int local) const { return n_[static_cast<std::size_t>(local)]; }
   /// Derivatives of normal(local) at the last update (computed once per update, cached);
   /// the Hessians only when asked for (the gap-variation form of contact needs none).
+  /// Safe to call from several threads at once (a threaded element loop).
   const NormalDerivatives& normal_derivatives(int local, bool hessians = true) const;
   /// Reference positions (u = 0).
   Vec3 reference(int local) const { return body_.mesh().points[body_node(local)]; }
@@ -86,8 +88,19 @@ class ContactSurface {
   std::vector<std::size_t> body_node_;
   std::vector<std::vector<int>> node_faces_;
   std::vector<Vec3> x_, n_;
+  void compute_normal_derivatives(int local, bool hessians, NormalDerivatives& d) const;
   mutable std::vector<NormalDerivatives> dn_;
-  mutable std::vector<char> dn_valid_;
+  mutable std::vector<char> dn_valid_;  // read and set through std::atomic_ref
+  // Striped locks for the first computation of a node's derivatives; a copy of the
+  // surface gets locks of its own.
+  struct Locks {
+    Locks() = default;
+    Locks(const Locks&) {}
+    Locks& operator=(const Locks&) { return *this; }
+    std::mutex& of(std::size_t node) const { return m[node % m.size()]; }
+    mutable std::array<std::mutex, 32> m;
+  };
+  Locks locks_;
   int reversed_ = 0;
 };
 

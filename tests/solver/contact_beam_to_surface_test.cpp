@@ -14,6 +14,7 @@
 #include <numbers>
 #include <random>
 
+#include "solver/assembly/threads.hpp"
 #include "solver/beams/beam_loads.hpp"
 #include "solver/beams/beam_term.hpp"
 #include "solver/contact/beam_to_surface_pair.hpp"
@@ -253,6 +254,48 @@ TEST(BeamContact, ForcesOnBeamAndSolidAreEqualAndOpposite) {
     EXPECT_GT(beam.norm(), 1e-3);
     EXPECT_LT((beam + solid).norm(), 1e-12 * beam.norm());
   }
+}
+
+TEST(BeamContact, ThreadedAssemblyAddsTheSerialBlocksInTheSerialOrder) {
+  // 40 elements: three chunks of the threaded loop, each with active points (the beam lies
+  // 0.03 mm into the block, perturbed). Both forms (the potential form reads the normals'
+  // Hessians). Blocks reach the assembler in element order, so the sums are the same bits.
+  for (const auto form : {contact::BeamContactForm::gap_variation, contact::BeamContactForm::potential}) {
+    auto s = make_setup(Mesh::tet10, kR - 0.03, 40, 0.0, 10.0, 1.6, form);
+    const Eigen::VectorXd u = perturbed(*s, 0.005, 5);
+    auto run = [&](int threads) {
+      const AssemblyThreads scope(threads);
+      s->pair->begin_step(SystemState{u, 1.0, 1.0});
+      return assemble_pair(*s->pair, u);
+    };
+    const auto serial = run(1), three = run(3), two = run(2);
+    EXPECT_GT(serial.r.norm(), 1e-3);
+    EXPECT_TRUE(serial.r == three.r && serial.k == three.k) << "3 threads: |dr| " << (serial.r - three.r).norm();
+    EXPECT_TRUE(serial.r == two.r && serial.k == two.k) << "2 threads: |dk| " << (serial.k - two.k).norm();
+  }
+  // A failure is the first in element order, as in the serial loop: every point was in contact
+  // in the last converged state, then the beam is moved off the block.
+  auto s = make_setup(Mesh::hex8, kR - 0.02, 40);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(s->model.dofs.size());
+  s->pair->begin_step(SystemState{u, 1.0, 1.0});
+  assemble_pair(*s->pair, u);
+  s->pair->commit();
+  Eigen::VectorXd off = u;
+  for (const auto& n : s->beam->dofs())
+    if (n.pos[0] >= 0) off[n.pos[0]] = 2.5;
+  std::vector<std::string> messages;
+  for (const int threads : {1, 3}) {
+    const AssemblyThreads scope(threads);
+    try {
+      assemble_pair(*s->pair, off);
+      ADD_FAILURE() << "no failure on " << threads << " threads";
+    } catch (const ElementFailure& e) {
+      messages.push_back(e.what());
+    }
+  }
+  ASSERT_EQ(messages.size(), 2u);
+  EXPECT_EQ(messages[0], messages[1]);
+  EXPECT_NE(messages[0].find("of beam element 0 "), std::string::npos) << messages[0];
 }
 
 TEST(BeamContact, APointThatLosesItsFaceWhileInContactFailsTheIteration) {

@@ -1,10 +1,15 @@
 // Threaded element loops (solver/assembly/threads.hpp, colouring.hpp): a solid
 // body's coloured assembly gives the serial matrix and residual to round-off,
 // and the same bits on any thread count; entries outside the pattern join it in
-// the coloured order; a failing element is reported alike on any count.
+// the coloured order; a failing element is reported alike on any count. The
+// ordered loop (parallel_ordered) consumes its chunks in order from their own
+// buffers and rethrows the first failure in that order.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <set>
+#include <thread>
 #include <string>
 
 #include "solver/assembly/colouring.hpp"
@@ -193,6 +198,64 @@ TEST(ThreadedAssembly, AFailingElementIsReportedAlikeOnAnyThreadCount) {
   ASSERT_EQ(messages.size(), 2u);
   EXPECT_EQ(messages[0], messages[1]);
   EXPECT_NE(messages[0].find("body 'block', element "), std::string::npos) << messages[0];
+}
+
+TEST(ParallelOrdered, ConsumesEveryChunkInOrderFromASlotNoOtherChunkHolds) {
+  // Computes sleep a little, the slower ones first, so later chunks finish their compute
+  // early: the consumer must still see chunk order, each chunk's own buffer, every item once.
+  for (const int threads : {1, 2, 3}) {
+    const AssemblyThreads scope(threads);
+    const int slots = ordered_slots();
+    EXPECT_EQ(slots, threads == 1 ? 1 : 2 * threads);
+    std::vector<std::vector<std::size_t>> buffer(static_cast<std::size_t>(slots));
+    std::vector<std::size_t> consumed;
+    std::atomic<int> busy{0}, most{0};
+    parallel_ordered(
+        103, 5,
+        [&](std::size_t begin, std::size_t end, int slot) {
+          const int now = ++busy;
+          for (int m = most.load(); now > m && !most.compare_exchange_weak(m, now);) {
+          }
+          auto& b = buffer.at(static_cast<std::size_t>(slot));
+          b.clear();
+          for (std::size_t i = begin; i < end; ++i) b.push_back(i);
+          std::this_thread::sleep_for(std::chrono::microseconds(begin % 3 == 0 ? 800 : 100));
+          --busy;
+        },
+        [&](std::size_t begin, std::size_t end, int slot) {
+          const auto& b = buffer.at(static_cast<std::size_t>(slot));
+          ASSERT_EQ(b.size(), end - begin);
+          for (std::size_t i = 0; i < b.size(); ++i) EXPECT_EQ(b[i], begin + i) << "slot " << slot << " was overwritten";
+          consumed.insert(consumed.end(), b.begin(), b.end());
+        });
+    ASSERT_EQ(consumed.size(), 103u);
+    for (std::size_t i = 0; i < consumed.size(); ++i) ASSERT_EQ(consumed[i], i) << threads << " threads";
+    if (threads > 1) EXPECT_GT(most.load(), 1) << "the computes never overlapped";
+  }
+}
+
+TEST(ParallelOrdered, RethrowsTheFirstFailureInChunkOrderAfterConsumingTheChunksBeforeIt) {
+  for (const int threads : {1, 3}) {
+    const AssemblyThreads scope(threads);
+    std::vector<std::size_t> consumed;
+    try {
+      parallel_ordered(
+          40, 2,
+          [&](std::size_t begin, std::size_t, int) {
+            // Chunk 9 fails at once, chunk 7 only after a while: in chunk order 7 comes first.
+            if (begin == 14) {
+              std::this_thread::sleep_for(std::chrono::milliseconds(20));
+              throw ElementFailure("chunk 7");
+            }
+            if (begin == 18) throw ElementFailure("chunk 9");
+          },
+          [&](std::size_t begin, std::size_t, int) { consumed.push_back(begin / 2); });
+      ADD_FAILURE() << "nothing thrown";
+    } catch (const ElementFailure& e) {
+      EXPECT_STREQ(e.what(), "chunk 7") << threads << " threads";
+    }
+    EXPECT_EQ(consumed, (std::vector<std::size_t>{0, 1, 2, 3, 4, 5, 6})) << threads << " threads";
+  }
 }
 
 TEST(AssemblyThreads, ScopeSetsTheCountAndTheEnvironmentGivesTheDefault) {
