@@ -172,8 +172,9 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
   const std::size_t ne = gauss_.size();
   // Threads project and integrate beam elements (the cost); their blocks reach the
   // assembler in element order (threads.hpp), so the sums are the one-thread loop's.
-  // An element writes only its own points' active flags and reserved faces; the
-  // surface's normal derivatives are computed once per update under its lock.
+  // An element writes only its own points' active flags; the faces it reserved are
+  // recorded with its blocks; the surface's normal derivatives are computed once per
+  // update under its lock.
   chunks_.resize(static_cast<std::size_t>(ordered_slots()));
   int unconverged = 0;
   parallel_ordered(
@@ -182,12 +183,14 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
         Chunk& c = chunks_[static_cast<std::size_t>(slot)];
         c.used = 0;
         c.unconverged = 0;
+        c.reserved.clear();
         for (std::size_t e = begin; e < end; ++e)
           if (state.owns(e, ne)) element_blocks(state, e, tangent, c);
       },
       [&](std::size_t, std::size_t, int slot) {
         Chunk& c = chunks_[static_cast<std::size_t>(slot)];
         for (std::size_t k = 0; k < c.used; ++k) out.add(c.blocks[k].dofs, c.blocks[k].r, c.blocks[k].k);
+        for (auto& [e, faces] : c.reserved) reserved_[e].swap(faces);
         unconverged += c.unconverged;
       });
   if (tangent) unconverged_ = unconverged;
@@ -352,8 +355,9 @@ void BeamToSurfacePair::element_blocks(const SystemState& state, std::size_t e, 
     // contact usually starts inside the pattern the solver has analysed. Only these: all the
     // search's candidate faces (every face within the margin of the element's box) made the
     // matrix 40 % larger and its LU fill 25 % (free expansion: 1.45 M against 1.04 M entries).
-    // The global pattern only grows, so a pair reserved once keeps its entries.
-    std::vector<int>& done = reserved_[e];
+    // The global pattern only grows, so a pair reserved once keeps its entries. The record
+    // is updated when the blocks reach the assembler (a chunk after a failing one never does).
+    const std::vector<int>& done = reserved_[e];
     std::sort(near.begin(), near.end());
     near.erase(std::unique(near.begin(), near.end()), near.end());
     bool added = false;
@@ -371,7 +375,7 @@ void BeamToSurfacePair::element_blocks(const SystemState& state, std::size_t e, 
     if (added) {
       std::vector<int> merged;
       std::set_union(done.begin(), done.end(), near.begin(), near.end(), std::back_inserter(merged));
-      done.swap(merged);
+      out.reserved.emplace_back(e, std::move(merged));
     }
   }
 }

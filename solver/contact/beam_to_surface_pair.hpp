@@ -32,6 +32,7 @@
 // elements of its fixed partition (SystemState::owns).
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/beams/beam_term.hpp"
@@ -136,6 +137,7 @@ class BeamToSurfacePair : public Term {
     std::vector<Block> blocks;
     std::size_t used = 0;
     int unconverged = 0;
+    std::vector<std::pair<std::size_t, std::vector<int>>> reserved;  // (element, its reserved faces after this chunk)
     Block& next();
   };
   /// Element e's blocks (pairs with active points, then reserved patterns) into `out`.
