@@ -50,7 +50,11 @@ int ordered_slots();
 /// scatter is a small share. `slot` < ordered_slots() names the buffer a chunk's
 /// compute fills and its consume reads: no two chunks in flight share one. A
 /// compute that throws stops the loop at its chunk's turn, so the exception
-/// rethrown here is the first in chunk order, as in the serial loop.
+/// rethrown here is the first in chunk order, as in the serial loop; up to
+/// ordered_slots() - 1 later chunks may have been computed by then but are not
+/// consumed. So a compute writes only its slot and state of its own items that
+/// the next complete loop overwrites; what must stay in step with the assembler
+/// is changed in consume.
 void parallel_ordered(std::size_t n, std::size_t grain, const std::function<void(std::size_t, std::size_t, int)>& compute,
                       const std::function<void(std::size_t, std::size_t, int)>& consume);
 

@@ -146,13 +146,16 @@ void BeamTerm::assemble(const SystemState& state, Assembler& out) {
   auto run = [&](auto& slots, auto kernel) {
     using System = typename std::decay_t<decltype(slots)>::value_type::value_type;
     slots.resize(static_cast<std::size_t>(ordered_slots()));
+    slot_dofs_.resize(slots.size());
     parallel_ordered(
         ne, kBeamChunk,
         [&](std::size_t begin, std::size_t end, int slot) {
           std::array<Eigen::Vector3d, 4> x;
           std::array<Eigen::Quaterniond, 3> q;
           auto& systems = slots[static_cast<std::size_t>(slot)];
+          auto& dofs = slot_dofs_[static_cast<std::size_t>(slot)];
           systems.resize(end - begin);
+          dofs.resize(end - begin);
           for (std::size_t e = begin; e < end; ++e) {
             if (!needed(e)) continue;
             gather(state.u, e, x, q);
@@ -160,12 +163,14 @@ void BeamTerm::assemble(const SystemState& state, Assembler& out) {
             s = System{};
             kernel(refs_[e], body_.section, x, q, s, hist_committed_.data() + hist_offset_[e],
                    hist_trial_.data() + hist_offset_[e], &work_trial_[e]);
+            if (state.owns(e, ne)) dofs[e - begin] = element_dofs(e);
           }
         },
         [&](std::size_t begin, std::size_t end, int slot) {
           const auto& systems = slots[static_cast<std::size_t>(slot)];
+          const auto& dofs = slot_dofs_[static_cast<std::size_t>(slot)];
           for (std::size_t e = begin; e < end; ++e)
-            if (state.owns(e, ne)) out.add(element_dofs(e), systems[e - begin].R, systems[e - begin].K);
+            if (state.owns(e, ne)) out.add(dofs[e - begin], systems[e - begin].R, systems[e - begin].K);
         });
   };
   if (body_.interpolation == BeamInterpolation::hermite3) run(hermite_slots_, element_system<4, 3>);

@@ -148,6 +148,7 @@ class BeamTerm : public Term {
   // Element systems a chunk of the threaded loop holds until its turn to scatter, per slot.
   std::vector<std::vector<ElementSystem<4, 3>>> hermite_slots_;
   std::vector<std::vector<ElementSystem<2, 2>>> linear_slots_;
+  std::vector<std::vector<std::vector<GlobalDof>>> slot_dofs_;  // and their elements' DOFs
   double plastic_work_committed_ = 0.0;
   // Which state the trial history belongs to: trial()/set_rotation() start a
   // new state, accept() marks it accepted, assemble() marks the history as

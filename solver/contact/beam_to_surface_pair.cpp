@@ -177,22 +177,33 @@ void BeamToSurfacePair::assemble(const SystemState& state, Assembler& out) {
   // update under its lock.
   chunks_.resize(static_cast<std::size_t>(ordered_slots()));
   int unconverged = 0;
-  parallel_ordered(
-      ne, kContactChunk,
-      [&](std::size_t begin, std::size_t end, int slot) {
-        Chunk& c = chunks_[static_cast<std::size_t>(slot)];
-        c.used = 0;
-        c.unconverged = 0;
-        c.reserved.clear();
-        for (std::size_t e = begin; e < end; ++e)
-          if (state.owns(e, ne)) element_blocks(state, e, tangent, c);
-      },
-      [&](std::size_t, std::size_t, int slot) {
-        Chunk& c = chunks_[static_cast<std::size_t>(slot)];
-        for (std::size_t k = 0; k < c.used; ++k) out.add(c.blocks[k].dofs, c.blocks[k].r, c.blocks[k].k);
-        for (auto& [e, faces] : c.reserved) reserved_[e].swap(faces);
-        unconverged += c.unconverged;
-      });
+  // The reservations of an assembly that fails here are undone: its pending entries never
+  // join the pattern (the next assembly starts afresh), so those faces are still unreserved.
+  std::vector<std::pair<std::size_t, std::vector<int>>> before;
+  try {
+    parallel_ordered(
+        ne, kContactChunk,
+        [&](std::size_t begin, std::size_t end, int slot) {
+          Chunk& c = chunks_[static_cast<std::size_t>(slot)];
+          c.used = 0;
+          c.unconverged = 0;
+          c.reserved.clear();
+          for (std::size_t e = begin; e < end; ++e)
+            if (state.owns(e, ne)) element_blocks(state, e, tangent, c);
+        },
+        [&](std::size_t, std::size_t, int slot) {
+          Chunk& c = chunks_[static_cast<std::size_t>(slot)];
+          for (std::size_t k = 0; k < c.used; ++k) out.add(c.blocks[k].dofs, c.blocks[k].r, c.blocks[k].k);
+          for (auto& [e, faces] : c.reserved) {
+            reserved_[e].swap(faces);
+            before.emplace_back(e, std::move(faces));
+          }
+          unconverged += c.unconverged;
+        });
+  } catch (...) {
+    for (auto& [e, faces] : before) reserved_[e].swap(faces);
+    throw;
+  }
   if (tangent) unconverged_ = unconverged;
 }
 
@@ -356,7 +367,9 @@ void BeamToSurfacePair::element_blocks(const SystemState& state, std::size_t e, 
     // search's candidate faces (every face within the margin of the element's box) made the
     // matrix 40 % larger and its LU fill 25 % (free expansion: 1.45 M against 1.04 M entries).
     // The global pattern only grows, so a pair reserved once keeps its entries. The record
-    // is updated when the blocks reach the assembler (a chunk after a failing one never does).
+    // is updated when the blocks reach the assembler (a chunk computed after a failing one
+    // never does) and undone if this pair's assembly fails (not if a later term's does: then
+    // the faces stay marked and their pattern comes with their first contact).
     const std::vector<int>& done = reserved_[e];
     std::sort(near.begin(), near.end());
     near.erase(std::unique(near.begin(), near.end()), near.end());

@@ -13,6 +13,8 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <string>
+#include <tuple>
 
 #include "solver/assembly/threads.hpp"
 #include "solver/beams/beam_loads.hpp"
@@ -25,6 +27,7 @@
 #include "solver/nonlinear/load_stepper.hpp"
 #include "tests/solver/beam_test_bodies.hpp"
 #include "tests/solver/dense_assembler.hpp"
+#include "tests/solver/recording_assembler.hpp"
 
 namespace stentsim::solver {
 namespace {
@@ -257,45 +260,82 @@ TEST(BeamContact, ForcesOnBeamAndSolidAreEqualAndOpposite) {
 }
 
 TEST(BeamContact, ThreadedAssemblyAddsTheSerialBlocksInTheSerialOrder) {
-  // 40 elements: three chunks of the threaded loop, each with active points (the beam lies
-  // 0.03 mm into the block, perturbed). Both forms (the potential form reads the normals'
-  // Hessians). Blocks reach the assembler in element order, so the sums are the same bits.
+  // 120 elements: 8 chunks of the threaded loop, more than its slots, with active points (the
+  // beam lies 0.03 mm into the block, perturbed) and reserved faces. Both forms (the potential
+  // form reads the normals' Hessians), tangent and residual-only, one rank and the second of
+  // two. A fresh pair per thread count, so each reserves its own faces.
   for (const auto form : {contact::BeamContactForm::gap_variation, contact::BeamContactForm::potential}) {
-    auto s = make_setup(Mesh::tet10, kR - 0.03, 40, 0.0, 10.0, 1.6, form);
-    const Eigen::VectorXd u = perturbed(*s, 0.005, 5);
-    auto run = [&](int threads) {
+    auto blocks = [&](int threads, bool tangent, int rank, int ranks) {
+      auto s = make_setup(Mesh::tet10, kR - 0.03, 120, 0.0, 10.0, 1.6, form);
+      const Eigen::VectorXd u = perturbed(*s, 0.005, 5);
       const AssemblyThreads scope(threads);
       s->pair->begin_step(SystemState{u, 1.0, 1.0});
-      return assemble_pair(*s->pair, u);
+      test::RecordingAssembler a(tangent);
+      s->pair->assemble(SystemState{u, 1.0, 1.0, rank, ranks}, a);
+      return a.blocks;
     };
-    const auto serial = run(1), three = run(3), two = run(2);
-    EXPECT_GT(serial.r.norm(), 1e-3);
-    EXPECT_TRUE(serial.r == three.r && serial.k == three.k) << "3 threads: |dr| " << (serial.r - three.r).norm();
-    EXPECT_TRUE(serial.r == two.r && serial.k == two.k) << "2 threads: |dk| " << (serial.k - two.k).norm();
-  }
-  // A failure is the first in element order, as in the serial loop: every point was in contact
-  // in the last converged state, then the beam is moved off the block.
-  auto s = make_setup(Mesh::hex8, kR - 0.02, 40);
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(s->model.dofs.size());
-  s->pair->begin_step(SystemState{u, 1.0, 1.0});
-  assemble_pair(*s->pair, u);
-  s->pair->commit();
-  Eigen::VectorXd off = u;
-  for (const auto& n : s->beam->dofs())
-    if (n.pos[0] >= 0) off[n.pos[0]] = 2.5;
-  std::vector<std::string> messages;
-  for (const int threads : {1, 3}) {
-    const AssemblyThreads scope(threads);
-    try {
-      assemble_pair(*s->pair, off);
-      ADD_FAILURE() << "no failure on " << threads << " threads";
-    } catch (const ElementFailure& e) {
-      messages.push_back(e.what());
+    for (const auto& [tangent, rank, ranks] : {std::tuple{true, 0, 1}, std::tuple{false, 0, 1}, std::tuple{true, 1, 2}}) {
+      const auto serial = blocks(1, tangent, rank, ranks);
+      EXPECT_GT(serial.size(), 16u);
+      EXPECT_TRUE(serial == blocks(2, tangent, rank, ranks)) << "2 threads, tangent " << tangent << ", rank " << rank;
+      EXPECT_TRUE(serial == blocks(3, tangent, rank, ranks)) << "3 threads, tangent " << tangent << ", rank " << rank;
     }
   }
-  ASSERT_EQ(messages.size(), 2u);
-  EXPECT_EQ(messages[0], messages[1]);
-  EXPECT_NE(messages[0].find("of beam element 0 "), std::string::npos) << messages[0];
+}
+
+TEST(BeamContact, AFailedThreadedAssemblyReportsTheFirstFailureAndReservesNothing) {
+  // In contact in the last converged state u. The trial state `off` shifts elements 0-15 and
+  // 48-89 along x by 0.25 mm and lifts them 0.03 mm (near faces not yet reserved, apart from
+  // them: only a near face with no active point reserves a zero block) and slides elements 40-47 and
+  // 90-119 off the block: the failure reported is the first of these on any thread count. The
+  // faces the shifted elements reserved in that failed assembly (chunk 0 consumed before the
+  // failure; chunks after it computed ahead on threads) never reached the pattern, so the
+  // assembly at the shifted state alone must add the same blocks, zero reserved ones
+  // included, as a pair that never failed.
+  auto run = [](int threads, bool fail) {
+    auto s = make_setup(Mesh::hex8, kR - 0.02, 120);
+    const AssemblyThreads scope(threads);
+    const Eigen::VectorXd u = Eigen::VectorXd::Zero(s->model.dofs.size());
+    s->pair->begin_step(SystemState{u, 1.0, 1.0});
+    assemble_pair(*s->pair, u);
+    s->pair->commit();
+    s->pair->begin_step(SystemState{u, 1.0, 1.0});
+    const auto& elements = s->beam->body().elements;
+    const auto& dofs = s->beam->dofs();
+    auto move = [&](Eigen::VectorXd& v, std::size_t e, int component, double by) {
+      for (const auto n : {elements[e].a, elements[e].b})
+        if (dofs[static_cast<std::size_t>(n)].pos[component] >= 0) v[dofs[static_cast<std::size_t>(n)].pos[component]] = by;
+    };
+    Eigen::VectorXd shifted = u;
+    for (std::size_t e = 0; e < elements.size(); ++e)
+      if (e < 16 || (e >= 48 && e <= 89)) move(shifted, e, 0, 0.25), move(shifted, e, 2, 0.03);
+    std::string message;
+    if (fail) {
+      Eigen::VectorXd off = shifted;
+      for (std::size_t e = 0; e < elements.size(); ++e)
+        if ((e >= 40 && e <= 47) || e >= 90) move(off, e, 1, 3.0);
+      try {
+        assemble_pair(*s->pair, off);
+        ADD_FAILURE() << "no failure on " << threads << " threads";
+      } catch (const ElementFailure& e) {
+        message = e.what();
+      }
+    }
+    test::RecordingAssembler a;
+    s->pair->assemble(SystemState{shifted, 1.0, 1.0}, a);
+    return std::pair{message, a.blocks};
+  };
+  const auto clean = run(1, false);
+  const auto serial = run(1, true), threaded = run(3, true);
+  // Element 39 shares its end node with 40, so it may be the first to lose its face.
+  EXPECT_TRUE(serial.first.find("of beam element 39 ") != std::string::npos ||
+              serial.first.find("of beam element 40 ") != std::string::npos) << serial.first;
+  EXPECT_EQ(serial.first, threaded.first);
+  std::size_t zero = 0;
+  for (const auto& b : clean.second) zero += b.r.isZero(0.0);
+  EXPECT_GT(zero, 0u) << "the shifted state reserves no face: the test sees no reservation";
+  EXPECT_TRUE(serial.second == clean.second) << "the serial pair kept reservations of its failed assembly";
+  EXPECT_TRUE(threaded.second == clean.second) << "the threaded pair kept reservations of its failed assembly";
 }
 
 TEST(BeamContact, APointThatLosesItsFaceWhileInContactFailsTheIteration) {

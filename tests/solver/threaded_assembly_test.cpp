@@ -201,7 +201,7 @@ TEST(ThreadedAssembly, AFailingElementIsReportedAlikeOnAnyThreadCount) {
 }
 
 TEST(ParallelOrdered, ConsumesEveryChunkInOrderFromASlotNoOtherChunkHolds) {
-  // Computes sleep a little, the slower ones first, so later chunks finish their compute
+  // Computes sleep a little, every third chunk longer, so later chunks finish their compute
   // early: the consumer must still see chunk order, each chunk's own buffer, every item once.
   for (const int threads : {1, 2, 3}) {
     const AssemblyThreads scope(threads);
@@ -209,13 +209,18 @@ TEST(ParallelOrdered, ConsumesEveryChunkInOrderFromASlotNoOtherChunkHolds) {
     EXPECT_EQ(slots, threads == 1 ? 1 : 2 * threads);
     std::vector<std::vector<std::size_t>> buffer(static_cast<std::size_t>(slots));
     std::vector<std::size_t> consumed;
-    std::atomic<int> busy{0}, most{0};
+    std::atomic<int> busy{0}, most{0}, started{0};
     parallel_ordered(
         103, 5,
         [&](std::size_t begin, std::size_t end, int slot) {
+          ++started;
           const int now = ++busy;
           for (int m = most.load(); now > m && !most.compare_exchange_weak(m, now);) {
           }
+          // The first chunk waits (a few seconds at most) for a second compute to start, so the
+          // overlap below does not depend on how fast a worker joins.
+          if (threads > 1 && begin == 0)
+            for (int k = 0; k < 5000 && started.load() < 2; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
           auto& b = buffer.at(static_cast<std::size_t>(slot));
           b.clear();
           for (std::size_t i = begin; i < end; ++i) b.push_back(i);
