@@ -12,6 +12,7 @@
 #include <exception>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/error.hpp"
@@ -71,9 +72,10 @@ void parallel_ordered(std::size_t n, std::size_t grain, const std::function<void
   grain = std::max<std::size_t>(1, grain);
   const std::size_t chunks = (n + grain - 1) / grain;
   const int slots = ordered_slots();
+  auto range = [&](std::size_t c) { return std::pair{c * grain, std::min(n, c * grain + grain)}; };
   if (slots == 1 || chunks <= 1) {
     for (std::size_t c = 0; c < chunks; ++c) {
-      const std::size_t begin = c * grain, end = std::min(n, begin + grain);
+      const auto [begin, end] = range(c);
       compute(begin, end, 0);
       consume(begin, end, 0);
     }
@@ -85,7 +87,6 @@ void parallel_ordered(std::size_t n, std::size_t grain, const std::function<void
   // by then: slot c % slots is never shared by two chunks in flight.
   std::vector<std::exception_ptr> failed(static_cast<std::size_t>(slots));
   std::size_t next = 0;
-  auto range = [&](std::size_t c) { return std::pair{c * grain, std::min(n, c * grain + grain)}; };
   arena->execute([&] {
     tbb::parallel_pipeline(
         static_cast<std::size_t>(slots),

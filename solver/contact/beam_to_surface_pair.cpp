@@ -147,14 +147,6 @@ NormalProjection BeamToSurfacePair::project(const ContactSurface& surface, const
 
 namespace {
 
-/// Accumulated contributions of one (beam element, face) pair in the variables
-/// v' = (beam centerline vectors [3 nc], face node positions [3 nf], nodal normals [3 nf]).
-struct PairBlock {
-  int face = -1;
-  Eigen::VectorXd g;
-  Eigen::MatrixXd k;
-};
-
 // Beam elements per chunk of the threaded loop (each projects its Gauss points on
 // a few faces and forms blocks of ~60 x 60).
 constexpr std::size_t kContactChunk = 16;
@@ -215,10 +207,13 @@ BeamToSurfacePair::Block& BeamToSurfacePair::Chunk::next() {
 void BeamToSurfacePair::element_blocks(const SystemState& state, std::size_t e, bool tangent, Chunk& out) {
   const bool potential = settings_.form == BeamContactForm::potential;
   const int ng = settings_.gauss_points, nq = 3 * nc_;
-  GapDerivatives gd;
-  NormalFieldDerivatives nd;
-  std::vector<PairBlock> blocks;
-  std::vector<int> near;  // the faces this element's points project onto within reach
+  // The slot's scratch, reused from element to element (no allocation once sized).
+  GapDerivatives& gd = out.gd;
+  NormalFieldDerivatives& nd = out.nd;
+  std::vector<PairBlock>& blocks = out.pairs;
+  std::vector<int>& near = out.near;  // the faces this element's points project onto within reach
+  blocks.clear();
+  near.clear();
   const auto x = centerline(state.u, e);
   for (int q = 0; q < ng; ++q) {
     const GaussPoint& gp = gauss_[e][static_cast<std::size_t>(q)];
@@ -311,7 +306,7 @@ void BeamToSurfacePair::element_blocks(const SystemState& state, std::size_t e, 
       for (int c = 0; c < 3; ++c) d.push_back(surface_->dof(n, c));
     return d;
   };
-  std::vector<int> patch;
+  std::vector<int>& patch = out.patch;
   for (const PairBlock& b : blocks) {
     const SurfaceFace& f = surface_->faces()[static_cast<std::size_t>(b.face)];
     patch_of(b.face, patch);

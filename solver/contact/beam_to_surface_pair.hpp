@@ -133,12 +133,24 @@ class BeamToSurfacePair : public Term {
     Eigen::VectorXd r;
     Eigen::MatrixXd k;
   };
+  /// Accumulated contributions of one (beam element, face) pair in the variables
+  /// v' = (beam centerline vectors [3 nc], face node positions [3 nf], nodal normals [3 nf]).
+  struct PairBlock {
+    int face = -1;
+    Eigen::VectorXd g;
+    Eigen::MatrixXd k;
+  };
   struct Chunk {
     std::vector<Block> blocks;
     std::size_t used = 0;
     int unconverged = 0;
     std::vector<std::pair<std::size_t, std::vector<int>>> reserved;  // (element, its reserved faces after this chunk)
     Block& next();
+    // element_blocks' scratch, kept for the slot's next element.
+    GapDerivatives gd;
+    NormalFieldDerivatives nd;
+    std::vector<PairBlock> pairs;
+    std::vector<int> near, patch;
   };
   /// Element e's blocks (pairs with active points, then reserved patterns) into `out`.
   void element_blocks(const SystemState& state, std::size_t e, bool tangent, Chunk& out);
